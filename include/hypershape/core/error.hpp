@@ -1,0 +1,44 @@
+#pragma once
+/// Error types and the PETSc call wrapper.
+///
+/// A bug is an `assert`; bad input is an `InputError` that names the file and the key; a failing
+/// PETSc call becomes a `PetscError` carrying the call text. Numerical failures of a load case
+/// are *not* exceptions: they are recorded outcomes (see solver/).
+#include <petscsys.h>
+
+#include <stdexcept>
+#include <string>
+
+namespace hypershape::core {
+
+/// Bad user input (scene/config file, mesh file, options). `what()` reads
+/// "<file>: <key>: <message>"; `file` or `key` may be empty when not applicable.
+class InputError : public std::runtime_error {
+ public:
+  InputError(std::string file, std::string key, const std::string& message);
+  const std::string& file() const { return file_; }
+  const std::string& key() const { return key_; }
+
+ private:
+  std::string file_, key_;
+};
+
+/// A PETSc call returned a non-zero error code.
+class PetscError : public std::runtime_error {
+ public:
+  PetscError(PetscErrorCode code, const char* call, const char* file, int line);
+  PetscErrorCode code() const { return code_; }
+
+ private:
+  PetscErrorCode code_;
+};
+
+/// Throws `PetscError` if `code` is non-zero. Use through HS_PETSC.
+inline void check_petsc(PetscErrorCode code, const char* call, const char* file, int line) {
+  if (code) throw PetscError(code, call, file, line);
+}
+
+}  // namespace hypershape::core
+
+/// Calls a PETSc function and throws hypershape::core::PetscError (with the call text) on failure.
+#define HS_PETSC(call) ::hypershape::core::check_petsc((call), #call, __FILE__, __LINE__)

@@ -1,0 +1,88 @@
+#pragma once
+/// Effects: the self-contained pieces a scene is assembled from. A scene lists its effects and
+/// only those are assembled. An effect may
+///   - mark boundary facets and impose homogeneous essential conditions on them (Dirichlet),
+///   - contribute a stored energy with its residual and tangent (a material),
+///   - contribute a dead load, a fixed external force vector scaled by the load factor
+///     (tractions, body forces).
+/// A new effect is one file that implements this interface plus one line in registry.cpp.
+#include <petscdm.h>
+#include <petscds.h>
+#include <petscmat.h>
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "hypershape/core/params.hpp"
+#include "hypershape/physics/space.hpp"
+
+namespace hypershape::physics {
+
+class Effect {
+ public:
+  virtual ~Effect() = default;
+  virtual std::string name() const = 0;
+
+  // ---- constraints ---------------------------------------------------------------------------
+  /// Labels the facets this effect constrains on the serial plex (every point on rank 0), before
+  /// distribution. Collective over the plex's communicator.
+  virtual void mark(DM /*serial*/) {}
+  virtual std::vector<EssentialBC> essential_bcs() const { return {}; }
+
+  // ---- set-up once the space exists ----------------------------------------------------------
+  /// Collective.
+  virtual void setup(const Space& /*space*/) {}
+
+  // ---- stored energy (materials) -------------------------------------------------------------
+  virtual bool has_energy() const { return false; }
+  /// Each adds over the local cells; `u` and `r` are local-vector arrays. Each returns false,
+  /// leaving partial sums, if some quadrature point has det F <= 0 (not collective).
+  virtual bool add_energy(const Space&, const PetscScalar* /*u*/, double& /*energy*/) const {
+    return true;
+  }
+  virtual bool add_residual(const Space&, const PetscScalar* /*u*/, PetscScalar* /*r*/) const {
+    return true;
+  }
+  virtual bool add_jacobian(const Space&, const PetscScalar* /*u*/, Mat /*J*/) const {
+    return true;
+  }
+  /// Registers the same physics as PETSc pointwise functions (generic assembly, cross-checks).
+  virtual void set_pointwise(PetscDS /*ds*/) const {}
+
+  // ---- dead loads -----------------------------------------------------------------------------
+  virtual bool has_load() const { return false; }
+  /// Adds the nominal external force into the local-vector array `f`. Not collective.
+  virtual void add_load(const Space&, PetscScalar* /*f*/) const {}
+};
+
+using EffectPtr = std::unique_ptr<Effect>;
+/// Builds an effect from its validated parameters for a problem of dimension `dim`.
+using EffectFactory = std::function<EffectPtr(const core::Params& params, int dim)>;
+
+/// Adds an effect to the registry (`help` is a one-line description with its keys).
+void register_effect(const std::string& name, EffectFactory factory, const std::string& help);
+/// Builds a registered effect; throws core::InputError (via params.fail) for unknown names.
+EffectPtr make_effect(const std::string& name, const core::Params& params, int dim);
+bool is_registered(const std::string& name);
+/// Registered names with their help lines, sorted by name.
+std::vector<std::pair<std::string, std::string>> registered_effects();
+
+// ---- effects built in C++ (verification problems, tests) ------------------------------------
+
+/// Selects boundary facets by the coordinates of their vertices (n_vertices x dim, row-major).
+using FacetPredicate = std::function<bool(const double* vertex_coords, int n_vertices, int dim)>;
+/// Traction t(x) per unit reference area (first Piola), writes dim components.
+using VectorFunction = std::function<void(const double* x, double* value)>;
+
+/// Homogeneous Dirichlet condition on the boundary facets selected by `select`, fixing
+/// `components` (all when empty). Each instance creates its own label `label_name`.
+EffectPtr make_dirichlet(std::string label_name, FacetPredicate select,
+                         std::vector<PetscInt> components = {});
+/// Dead surface traction t(x) on the Neumann facets selected by `select` (all when empty).
+EffectPtr make_surface_traction(VectorFunction traction, FacetPredicate select = {});
+/// Dead body force b(x) per unit reference volume.
+EffectPtr make_body_force(VectorFunction force, int quadrature_degree = 0);
+
+}  // namespace hypershape::physics

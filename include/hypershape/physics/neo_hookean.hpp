@@ -1,0 +1,65 @@
+#pragma once
+/// The seed paper's compressible Neo-Hookean material (appendix A):
+///   W(F) = mu/2 (tr(F^T F) - d - 2 ln J) + lambda/2 (ln J)^2,   J = det F,
+///   P = dW/dF = mu (F - F^{-T}) + lambda ln J F^{-T},
+///   A_{iJkL} = dP_{iJ}/dF_{kL} = mu d_ik d_JL + (mu - lambda ln J) F^{-1}_{Li} F^{-1}_{Jk}
+///              + lambda F^{-1}_{Ji} F^{-1}_{Lk}.
+/// In 2D this is plane strain (F_33 = 1 contributes tr 1 - 1 = 0). Pure, allocation-free,
+/// fixed-size: every function returns false (and leaves outputs untouched) if J <= 0.
+#include <Eigen/Dense>
+#include <cmath>
+
+namespace hypershape::physics {
+
+template <int D>
+using Tensor = Eigen::Matrix<double, D, D>;
+/// The tangent as a (D*D) x (D*D) matrix, A(i*D + J, k*D + L) = dP_iJ / dF_kL.
+template <int D>
+using Tangent = Eigen::Matrix<double, D * D, D * D>;
+
+/// Lame parameters from Young's modulus and Poisson's ratio.
+struct Lame {
+  double mu, lambda;
+  static Lame from_young_poisson(double E, double nu) {
+    return {E / (2.0 * (1.0 + nu)), E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))};
+  }
+};
+
+template <int D>
+struct NeoHookean {
+  double mu = 0, lambda = 0;
+
+  bool energy(const Tensor<D>& F, double& W) const {
+    const double J = F.determinant();
+    if (!(J > 0)) return false;
+    const double lnJ = std::log(J);
+    W = 0.5 * mu * (F.squaredNorm() - D - 2.0 * lnJ) + 0.5 * lambda * lnJ * lnJ;
+    return true;
+  }
+
+  bool stress(const Tensor<D>& F, Tensor<D>& P) const {
+    const double J = F.determinant();
+    if (!(J > 0)) return false;
+    const Tensor<D> FinvT = F.inverse().transpose();
+    P = mu * (F - FinvT) + (lambda * std::log(J)) * FinvT;
+    return true;
+  }
+
+  bool stress_tangent(const Tensor<D>& F, Tensor<D>& P, Tangent<D>& A) const {
+    const double J = F.determinant();
+    if (!(J > 0)) return false;
+    const Tensor<D> Fi = F.inverse();
+    const double lnJ = std::log(J);
+    P = mu * (F - Fi.transpose()) + (lambda * lnJ) * Fi.transpose();
+    const double c1 = mu - lambda * lnJ;
+    for (int i = 0; i < D; ++i)
+      for (int J_ = 0; J_ < D; ++J_)
+        for (int k = 0; k < D; ++k)
+          for (int L = 0; L < D; ++L)
+            A(i * D + J_, k * D + L) = (i == k && J_ == L ? mu : 0.0) + c1 * Fi(L, i) * Fi(J_, k) +
+                                       lambda * Fi(J_, i) * Fi(L, k);
+    return true;
+  }
+};
+
+}  // namespace hypershape::physics

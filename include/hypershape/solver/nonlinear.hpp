@@ -1,0 +1,102 @@
+#pragma once
+/// Nonlinear solves of one Problem: one SNES (and so one matrix, one KSP and one symbolic
+/// factorisation) kept for all its load cases.
+///
+/// Defaults (each overridable in the PETSc options database, prefix "" unless given):
+///   -snes_type newtonls with our guarded line search (type shell): a trial state with
+///   det F <= 0 has energy +inf and is never accepted (the "guard"); an admissible one is taken
+///   on Armijo decrease of the potential energy, or of the residual norm where the tangent is
+///   indefinite or the energy change is below round-off. (PETSc 3.18's bt with an objective
+///   models 1/2 obj with the full slope and stalls on indefinite tangents: measured here.)
+///   -ksp_type preonly -pc_type cholesky -pc_factor_mat_solver_type mumps (the Neo-Hookean
+///   tangent is symmetric; LDL^T was 1.6x faster than LU here);
+///   -snes_stol 0 (a small step is not convergence: the residual must be small).
+/// Load continuation: if a step fails, return to the last converged state and halve the
+/// increment; after a success, double it.
+#include <petscsnes.h>
+
+#include <string>
+
+#include "hypershape/core/petsc_handle.hpp"
+#include "hypershape/physics/problem.hpp"
+
+namespace hypershape::solver {
+
+struct SolverOptions {
+  double rtol = 1e-9;          ///< converged when ||R|| <= rtol ||alpha f_ext|| (+ atol)
+  double atol = 1e-12;
+  int max_newton = 12;         ///< Newton iterations per increment (then: smaller increment)
+  int max_increments = 64;     ///< continuation increments per solve
+  double min_increment = 1e-4; ///< smallest increment, relative to the requested change
+  bool guard = true;           ///< energy objective + bt line search (else: full Newton steps)
+  double target_rtol = 1e-3;   ///< alpha search: |max|u| / target - 1| <= target_rtol
+  int max_target_solves = 30;
+};
+
+/// Outcome of one solve: data, never an exception.
+struct SolveResult {
+  bool converged = false;
+  std::string reason;          ///< PETSc's converged reason of the last SNES solve, or ours
+  int newton_iterations = 0;   ///< total over increments (failed ones included)
+  int linear_solves = 0;
+  int increments = 0;          ///< successful increments
+  int failed_increments = 0;
+  double load_factor = 0;      ///< reached load factor (= requested if converged)
+  double residual_norm = 0;
+  double max_displacement = 0;
+};
+
+struct TargetResult {
+  bool converged = false;
+  std::string reason;
+  double alpha = 0;
+  double max_displacement = 0;
+  int solves = 0;              ///< nonlinear solves (alpha evaluations)
+  int newton_iterations = 0;
+  int failed_increments = 0;
+};
+
+class NonlinearSolver {
+ public:
+  /// Collective over the problem's communicator; reads PETSc options with `prefix`.
+  NonlinearSolver(const physics::Problem& problem, const SolverOptions& opt = {},
+                  const std::string& prefix = "");
+  NonlinearSolver(const NonlinearSolver&) = delete;
+  NonlinearSolver& operator=(const NonlinearSolver&) = delete;
+
+  /// The current (last converged) displacement, a global vector.
+  Vec solution() const { return u_.get(); }
+  double load_factor() const { return s_; }
+  /// Back to u = 0 at load factor 0.
+  void reset();
+  /// Solves R(u) = f_int(u) - s f_ext = 0 at load factor `s`, continuing from the current state.
+  SolveResult solve(double load_factor);
+  /// Finds alpha with |max|u| / target - 1| <= target_rtol, reusing the state, matrix and
+  /// factorisation structure between evaluations.
+  TargetResult solve_for_target(double target);
+  /// max|u| of the linear response to the nominal load at the current state (one linear solve).
+  double linear_response();
+
+  SNES snes() const { return snes_.get(); }
+  Mat jacobian_matrix() const { return J_.get(); }
+  const physics::Problem& problem() const { return problem_; }
+
+ private:
+  static PetscErrorCode form_function(SNES, Vec, Vec, void*);
+  static PetscErrorCode form_jacobian(SNES, Vec, Mat, Mat, void*);
+  static PetscErrorCode form_objective(SNES, Vec, PetscReal*, void*);
+  static PetscErrorCode guarded_line_search(SNESLineSearch, void*);
+  void line_search(SNESLineSearch ls);
+  bool newton(double s, SolveResult& r);
+
+  const physics::Problem& problem_;
+  SolverOptions opt_;
+  core::SNESH snes_;
+  core::MatH J_;
+  core::VecH u_, backup_, r_;
+  double s_ = 0;        ///< load factor of the current state
+  double s_eval_ = 0;   ///< load factor the callbacks assemble at
+  bool user_atol_ = false;
+};
+
+}  // namespace hypershape::solver

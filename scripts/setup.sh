@@ -1,0 +1,52 @@
+#!/usr/bin/env bash
+# Installs what hypershape needs from Debian 12 (only what is missing), then configures and
+# builds it (Release) in ./build. Idempotent: a second run with nothing changed takes seconds.
+#   scripts/setup.sh            # packages + configure + build
+#   BUILD_DIR=build-dev BUILD_TYPE=Developer scripts/setup.sh
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+# Each package and what it is for (the README's dependency table says the same).
+PACKAGES=(
+  g++ cmake make pkg-config git     # toolchain
+  petsc-dev                         # PETSc 3.18: DMPlex, PetscFE, SNES, KSP; MUMPS, hypre
+  libpetsc3.18-dev-examples         # PETSc's tutorials (reference for the API)
+  libgmsh-dev                       # gmsh C++ API: meshes built in-process
+  libmetis-dev                      # METIS: mesh partitions for groups of ranks
+  libhdf5-openmpi-dev               # parallel HDF5: results and dataset shards
+  libeigen3-dev                     # fixed-size small linear algebra in kernels
+  catch2                            # unit-test framework (v2.13)
+  openmpi-bin                       # mpiexec
+  libopenblas0-serial               # optimised BLAS for MUMPS (4-6x faster factorisations)
+  libyaml-cpp-dev                   # scene and dataset files
+  libcli11-dev                      # command-line parsing
+  libfmt-dev                        # formatting (GCC 12 has no <format>)
+  nlohmann-json3-dev                # JSON reports and benchmarks
+  python3-h5py python3-numpy        # Python readers and checks of the output
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  if [ "$(id -u)" = 0 ]; then
+    echo "[setup] installing: ${missing[*]}"
+    export DEBIAN_FRONTEND=noninteractive
+    apt-get update -qq
+    apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+  else
+    echo "[setup] missing Debian packages. Run as root:"
+    echo "  apt-get update && apt-get install -y --no-install-recommends ${missing[*]}"
+    exit 1
+  fi
+fi
+
+BUILD_DIR=${BUILD_DIR:-build}
+BUILD_TYPE=${BUILD_TYPE:-Release}
+if [ ! -f "$BUILD_DIR/CMakeCache.txt" ]; then
+  cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE="$BUILD_TYPE" >/dev/null
+fi
+cmake --build "$BUILD_DIR" -j "$(nproc)" 2>&1 | grep -v "^\[ *[0-9]*%\]" || true
+test "${PIPESTATUS[0]}" -eq 0
+echo "[setup] build ready in $BUILD_DIR"

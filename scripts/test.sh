@@ -1,0 +1,12 @@
+#!/usr/bin/env bash
+# Sets up (packages, configure, build) and runs the whole test suite with CTest.
+# Slow tests carry the CTest label "slow" and run only with: scripts/test.sh -L slow
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scripts/setup.sh
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
+export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
+args=("$@")
+[ ${#args[@]} -eq 0 ] && args=(-LE slow)
+cd "${BUILD_DIR:-build}"
+ctest --output-on-failure "${args[@]}"

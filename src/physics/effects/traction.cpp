@@ -1,0 +1,131 @@
+/// Dead surface tractions on the Neumann boundary, and the effect "gaussian_traction" of the
+/// seed paper (section 3.2): t(x) = alpha g phi(x - p_N) / I_N, phi(y) = exp(-|y|^2/(2 gamma^2)),
+/// I_N = int_{Gamma_N} phi dS by the facet rule. alpha is the problem's load factor.
+/// Keys: center (p_N), direction (g, normalised here), gamma (> 0).
+#include <cmath>
+
+#include "hypershape/core/error.hpp"
+#include "hypershape/physics/registry.hpp"
+
+namespace hypershape::physics {
+
+namespace {
+
+/// Integrates `fn(x, weight)` over the selected Neumann facets with the facet rule.
+template <class Fn>
+void for_each_facet_point(const Space& s, const FacetPredicate& select, Fn&& fn) {
+  const int dim = s.dim();
+  for (const FacetView& f : s.neumann_facets()) {
+    if (select) {
+      double x[9];
+      for (int a = 0; a < f.n_vertices; ++a)
+        for (int k = 0; k < dim; ++k) x[a * dim + k] = f.x[a][k];
+      if (!select(x, f.n_vertices, dim)) continue;
+    }
+    const double measure = Space::facet_measure(f, dim);
+    for (int q = 0; q < s.n_facet_qp(); ++q) {
+      const double* bary = s.facet_bary(q);
+      double x[3] = {0, 0, 0};
+      for (int a = 0; a < f.n_vertices; ++a)
+        for (int k = 0; k < dim; ++k) x[k] += bary[a] * f.x[a][k];
+      fn(f, bary, x, s.facet_qweight(q) * measure);
+    }
+  }
+}
+
+class SurfaceTraction : public Effect {
+ public:
+  SurfaceTraction(std::string name, VectorFunction t, FacetPredicate select)
+      : name_(std::move(name)), traction_(std::move(t)), select_(std::move(select)) {}
+  std::string name() const override { return name_; }
+  bool has_load() const override { return true; }
+  void add_load(const Space& s, PetscScalar* f) const override {
+    const int dim = s.dim();
+    for_each_facet_point(s, select_, [&](const FacetView& fv, const double* bary, const double* x,
+                                         double w) {
+      double t[3] = {0, 0, 0};
+      traction_(x, t);
+      for (int n = 0; n < fv.n_nodes; ++n) {
+        const double wn = w * s.facet_basis(fv.ends[n], bary);
+        for (int i = 0; i < dim; ++i) f[fv.offset[n] + i] += wn * t[i];
+      }
+    });
+  }
+
+ protected:
+  std::string name_;
+  VectorFunction traction_;
+  FacetPredicate select_;
+};
+
+class GaussianTraction : public SurfaceTraction {
+ public:
+  GaussianTraction(std::vector<double> center, std::vector<double> g, double gamma)
+      : SurfaceTraction("gaussian_traction", {}, {}),
+        center_(std::move(center)),
+        g_(std::move(g)),
+        gamma_(gamma) {}
+
+  void setup(const Space& s) override {
+    double integral = 0;
+    for_each_facet_point(s, {}, [&](const FacetView&, const double*, const double* x, double w) {
+      integral += w * phi(x, s.dim());
+    });
+    MPI_Allreduce(MPI_IN_PLACE, &integral, 1, MPI_DOUBLE, MPI_SUM, s.comm());
+    if (!(integral > 0))
+      throw core::InputError("", "gaussian_traction",
+                             "the Neumann boundary is empty or far from the traction centre "
+                             "(int phi = 0)");
+    normaliser_ = integral;
+    const int dim = s.dim();
+    traction_ = [this, dim](const double* x, double* t) {
+      const double v = phi(x, dim) / normaliser_;
+      for (int i = 0; i < dim; ++i) t[i] = g_[i] * v;
+    };
+  }
+  double normaliser() const { return normaliser_; }
+
+ private:
+  double phi(const double* x, int dim) const {
+    double r2 = 0;
+    for (int k = 0; k < dim; ++k) r2 += (x[k] - center_[k]) * (x[k] - center_[k]);
+    return std::exp(-r2 / (2.0 * gamma_ * gamma_));
+  }
+  std::vector<double> center_, g_;
+  double gamma_;
+  double normaliser_ = 0;
+};
+
+}  // namespace
+
+EffectPtr make_surface_traction(VectorFunction traction, FacetPredicate select) {
+  return std::make_unique<SurfaceTraction>("surface_traction", std::move(traction), std::move(select));
+}
+
+EffectPtr make_gaussian_traction(const std::vector<double>& center,
+                                 const std::vector<double>& direction, double gamma) {
+  double n = 0;
+  for (double v : direction) n += v * v;
+  n = std::sqrt(n);
+  std::vector<double> g(direction);
+  for (double& v : g) v /= n;
+  return std::make_unique<GaussianTraction>(center, g, gamma);
+}
+
+void register_gaussian_traction() {
+  register_effect(
+      "gaussian_traction",
+      [](const core::Params& p, int dim) {
+        auto c = p.vector("center", std::size_t(dim));
+        auto g = p.vector("direction", std::size_t(dim));
+        double n = 0;
+        for (double v : g) n += v * v;
+        if (!(n > 0)) p.fail("direction", "must be a non-zero vector");
+        const double gamma = p.number_in("gamma", 0.0, 1e300, true);
+        return make_gaussian_traction(c, g, gamma);
+      },
+      "Gaussian surface traction g phi(x - p_N) / I_N (scaled by alpha); keys: center (p_N), "
+      "direction (g), gamma > 0");
+}
+
+}  // namespace hypershape::physics

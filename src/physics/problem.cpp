@@ -1,0 +1,248 @@
+#include "hypershape/physics/problem.hpp"
+
+#include <petscdmplex.h>
+#include <petscsnes.h>
+
+#include <cmath>
+
+#include "hypershape/core/error.hpp"
+#include "hypershape/mesh/plex.hpp"
+#include "hypershape/physics/hyperelastic.hpp"
+
+namespace hypershape::physics {
+
+namespace {
+
+/// Borrowed local vector with array access, restored on scope exit.
+class LocalArray {
+ public:
+  LocalArray(DM dm, bool write) : dm_(dm), write_(write) {
+    HS_PETSC(DMGetLocalVector(dm, &v_));
+    if (write) HS_PETSC(VecZeroEntries(v_));
+  }
+  ~LocalArray() {
+    if (a_) write_ ? VecRestoreArray(v_, &a_) : VecRestoreArrayRead(v_, (const PetscScalar**)&a_);
+    DMRestoreLocalVector(dm_, &v_);
+  }
+  Vec vec() const { return v_; }
+  PetscScalar* array() {
+    if (!a_) {
+      if (write_) HS_PETSC(VecGetArray(v_, &a_));
+      else HS_PETSC(VecGetArrayRead(v_, (const PetscScalar**)&a_));
+    }
+    return a_;
+  }
+  void release() {
+    if (a_) {
+      write_ ? VecRestoreArray(v_, &a_) : VecRestoreArrayRead(v_, (const PetscScalar**)&a_);
+      a_ = nullptr;
+    }
+  }
+
+ private:
+  DM dm_;
+  Vec v_ = nullptr;
+  PetscScalar* a_ = nullptr;
+  bool write_;
+};
+
+bool all_ranks(MPI_Comm comm, bool ok) {
+  int v = ok ? 1 : 0;
+  MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_INT, MPI_MIN, comm);
+  return v == 1;
+}
+
+}  // namespace
+
+Problem::Problem(MPI_Comm comm, const mesh::MeshData& mesh, std::vector<EffectPtr> effects,
+                 const SpaceOptions& opt)
+    : effects_(std::move(effects)) {
+  core::DMH serial = mesh::create_plex(comm, mesh);
+  std::vector<EssentialBC> bcs;
+  for (auto& e : effects_) {
+    e->mark(serial);
+    for (auto& bc : e->essential_bcs()) bcs.push_back(bc);
+  }
+  core::SFH migration;
+  core::DMH dist = mesh::distribute(serial, migration);
+  const bool distributed = bool(dist);
+  // Space takes the plex it works on; keep the serial one alive for the canonical numbering.
+  if (distributed) {
+    space_ = std::make_unique<Space>(std::move(dist), serial.get(), migration.get(), opt, bcs);
+  } else {
+    DM clone;
+    HS_PETSC(PetscObjectReference((PetscObject)serial.get()));
+    clone = serial.get();
+    space_ = std::make_unique<Space>(core::DMH(clone), serial.get(), nullptr, opt, bcs);
+  }
+  for (auto& e : effects_) e->setup(*space_);
+
+  // Nominal dead load.
+  HS_PETSC(DMCreateGlobalVector(dm(), load_.out()));
+  HS_PETSC(VecZeroEntries(load_));
+  LocalArray fl(dm(), true);
+  for (auto& e : effects_)
+    if (e->has_load()) e->add_load(*space_, fl.array());
+  fl.release();
+  HS_PETSC(DMLocalToGlobal(dm(), fl.vec(), ADD_VALUES, load_));
+  HS_PETSC(VecNorm(load_, NORM_2, &load_norm_));
+}
+
+void Problem::to_local(Vec u, Vec ul) const {
+  HS_PETSC(DMGlobalToLocal(dm(), u, INSERT_VALUES, ul));
+  HS_PETSC(DMPlexInsertBoundaryValues(dm(), PETSC_TRUE, ul, 0.0, nullptr, nullptr, nullptr));
+}
+
+bool Problem::energy(Vec u, double load_factor, double& value) const {
+  LocalArray ul(dm(), false);
+  to_local(u, ul.vec());
+  double e = 0;
+  bool ok = true;
+  for (auto& eff : effects_)
+    if (eff->has_energy()) ok = ok && eff->add_energy(*space_, ul.array(), e);
+  ok = all_ranks(comm(), ok);
+  MPI_Allreduce(MPI_IN_PLACE, &e, 1, MPI_DOUBLE, MPI_SUM, comm());
+  PetscScalar work;
+  HS_PETSC(VecDot(load_, u, &work));
+  value = ok ? e - load_factor * PetscRealPart(work) : INFINITY;
+  return ok;
+}
+
+bool Problem::residual(Vec u, double load_factor, Vec r) const {
+  LocalArray ul(dm(), false), rl(dm(), true);
+  to_local(u, ul.vec());
+  bool ok = true;
+  for (auto& eff : effects_)
+    if (eff->has_energy()) ok = ok && eff->add_residual(*space_, ul.array(), rl.array());
+  ok = all_ranks(comm(), ok);
+  rl.release();
+  HS_PETSC(VecZeroEntries(r));
+  HS_PETSC(DMLocalToGlobal(dm(), rl.vec(), ADD_VALUES, r));
+  if (load_factor != 0.0) HS_PETSC(VecAXPY(r, -load_factor, load_));
+  return ok;
+}
+
+bool Problem::jacobian(Vec u, Mat J) const {
+  LocalArray ul(dm(), false);
+  to_local(u, ul.vec());
+  HS_PETSC(MatZeroEntries(J));
+  bool ok = true;
+  for (auto& eff : effects_)
+    if (eff->has_energy()) ok = ok && eff->add_jacobian(*space_, ul.array(), J);
+  HS_PETSC(MatAssemblyBegin(J, MAT_FINAL_ASSEMBLY));
+  HS_PETSC(MatAssemblyEnd(J, MAT_FINAL_ASSEMBLY));
+  return all_ranks(comm(), ok);
+}
+
+void Problem::residual_pointwise(Vec u, Vec r) const {
+  PetscDS ds;
+  HS_PETSC(DMGetDS(dm(), &ds));
+  for (auto& eff : effects_)
+    if (eff->has_energy()) eff->set_pointwise(ds);
+  LocalArray ul(dm(), false), rl(dm(), true);
+  to_local(u, ul.vec());
+  HS_PETSC(DMPlexSNESComputeResidualFEM(dm(), ul.vec(), rl.vec(), nullptr));
+  HS_PETSC(VecZeroEntries(r));
+  HS_PETSC(DMLocalToGlobal(dm(), rl.vec(), ADD_VALUES, r));
+}
+
+void Problem::jacobian_pointwise(Vec u, Mat J) const {
+  PetscDS ds;
+  HS_PETSC(DMGetDS(dm(), &ds));
+  for (auto& eff : effects_)
+    if (eff->has_energy()) eff->set_pointwise(ds);
+  LocalArray ul(dm(), false);
+  to_local(u, ul.vec());
+  HS_PETSC(DMPlexSNESComputeJacobianFEM(dm(), ul.vec(), J, J, nullptr));
+}
+
+double Problem::max_displacement(Vec u) const {
+  LocalArray ul(dm(), false);
+  to_local(u, ul.vec());
+  const PetscScalar* a = ul.array();
+  double m = 0;
+  for (const auto& n : space_->owned_nodes()) {
+    double s = 0;
+    for (int i = 0; i < space_->dim(); ++i) s += a[n.offset + i] * a[n.offset + i];
+    m = std::max(m, s);
+  }
+  MPI_Allreduce(MPI_IN_PLACE, &m, 1, MPI_DOUBLE, MPI_MAX, comm());
+  return std::sqrt(m);
+}
+
+double Problem::min_det_f(Vec u) const {
+  LocalArray ul(dm(), false);
+  to_local(u, ul.vec());
+  const PetscScalar* a = ul.array();
+  const Space& s = *space_;
+  double m = INFINITY;
+  detail::dispatch<NeoHookean>(s, [&]<int D, int NB>() {
+    Eigen::Matrix<double, NB, D> ue, G;
+    for (PetscInt c = s.cell_begin(); c < s.cell_end(); ++c) {
+      detail::gather<D, NB>(s, c, a, ue);
+      for (int q = 0; q < s.n_qp(); ++q) {
+        detail::physical_gradients<D, NB>(s, c, q, G);
+        m = std::min(m, (Tensor<D>::Identity() + ue.transpose() * G).determinant());
+      }
+    }
+    return true;
+  });
+  MPI_Allreduce(MPI_IN_PLACE, &m, 1, MPI_DOUBLE, MPI_MIN, comm());
+  return m;
+}
+
+NodalField Problem::gather(Vec u) const {
+  LocalArray ul(dm(), false);
+  to_local(u, ul.vec());
+  const PetscScalar* a = ul.array();
+  const int dim = space_->dim();
+  std::vector<double> send;
+  std::vector<long long> ids;
+  for (const auto& n : space_->owned_nodes()) {
+    ids.push_back(n.canonical);
+    for (int i = 0; i < dim; ++i) send.push_back(PetscRealPart(a[n.offset + i]));
+  }
+  const int nr = core::size(comm());
+  int n_local = int(ids.size());
+  std::vector<int> counts(nr), displs(nr, 0);
+  MPI_Gather(&n_local, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm());
+  for (int r = 1; r < nr; ++r) displs[r] = displs[r - 1] + counts[r - 1];
+  const int total = core::rank(comm()) == 0 ? displs[nr - 1] + counts[nr - 1] : 0;
+  std::vector<long long> all_ids(total);
+  MPI_Gatherv(ids.data(), n_local, MPI_LONG_LONG, all_ids.data(), counts.data(), displs.data(),
+              MPI_LONG_LONG, 0, comm());
+  for (int r = 0; r < nr; ++r) {
+    counts[r] *= dim;
+    displs[r] *= dim;
+  }
+  std::vector<double> all_vals(std::size_t(total) * dim);
+  MPI_Gatherv(send.data(), n_local * dim, MPI_DOUBLE, all_vals.data(), counts.data(),
+              displs.data(), MPI_DOUBLE, 0, comm());
+  NodalField out;
+  out.n_components = dim;
+  if (core::rank(comm()) == 0) {
+    if (total != space_->n_nodes_global())
+      throw std::logic_error("gathered node count differs from the mesh's");
+    out.values.assign(std::size_t(total) * dim, 0.0);
+    for (int k = 0; k < total; ++k)
+      for (int i = 0; i < dim; ++i) out.values[std::size_t(all_ids[k]) * dim + i] = all_vals[std::size_t(k) * dim + i];
+  }
+  return out;
+}
+
+core::MatH Problem::create_matrix() const {
+  core::MatH J;
+  HS_PETSC(DMCreateMatrix(dm(), J.out()));
+  HS_PETSC(MatSetOption(J, MAT_SYMMETRIC, PETSC_TRUE));
+  HS_PETSC(MatSetOption(J, MAT_SYMMETRY_ETERNAL, PETSC_TRUE));
+  return J;
+}
+
+core::VecH Problem::create_vector() const {
+  core::VecH v;
+  HS_PETSC(DMCreateGlobalVector(dm(), v.out()));
+  HS_PETSC(VecZeroEntries(v));
+  return v;
+}
+
+}  // namespace hypershape::physics

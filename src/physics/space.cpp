@@ -1,0 +1,383 @@
+#include "hypershape/physics/space.hpp"
+
+#include <petscds.h>
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "hypershape/core/error.hpp"
+#include "hypershape/mesh/plex.hpp"
+
+namespace hypershape::physics {
+
+namespace {
+
+PetscErrorCode zero_value(PetscInt, PetscReal, const PetscReal[], PetscInt nc, PetscScalar u[],
+                          void*) {
+  for (PetscInt c = 0; c < nc; ++c) u[c] = 0.0;
+  return 0;
+}
+
+/// Vertex coordinates of `v` from the local coordinate vector.
+std::array<double, 3> vertex_coords(PetscSection cs, const PetscScalar* xa, PetscInt v, int dim) {
+  PetscInt off;
+  HS_PETSC(PetscSectionGetOffset(cs, v, &off));
+  std::array<double, 3> x{0, 0, 0};
+  for (int k = 0; k < dim; ++k) x[k] = PetscRealPart(xa[off + k]);
+  return x;
+}
+
+/// Coordinates of the node carried by point p (a vertex, or the midpoint of an edge).
+std::array<double, 3> node_coords(DM dm, PetscSection cs, const PetscScalar* xa, PetscInt p,
+                                  int dim) {
+  PetscInt depth;
+  HS_PETSC(DMPlexGetPointDepth(dm, p, &depth));
+  if (depth == 0) return vertex_coords(cs, xa, p, dim);
+  const PetscInt* cone;
+  HS_PETSC(DMPlexGetCone(dm, p, &cone));
+  auto a = vertex_coords(cs, xa, cone[0], dim), b = vertex_coords(cs, xa, cone[1], dim);
+  for (int k = 0; k < 3; ++k) a[k] = 0.5 * (a[k] + b[k]);
+  return a;
+}
+
+/// Closure points of `p` of depth `depth`, in closure order.
+std::vector<PetscInt> closure_of_depth(DM dm, PetscInt p, PetscInt d0, PetscInt d1) {
+  PetscInt n, *cl = nullptr;
+  HS_PETSC(DMPlexGetTransitiveClosure(dm, p, PETSC_TRUE, &n, &cl));
+  std::vector<PetscInt> out;
+  for (PetscInt i = 0; i < n; ++i)
+    if (cl[2 * i] >= d0 && cl[2 * i] < d1) out.push_back(cl[2 * i]);
+  HS_PETSC(DMPlexRestoreTransitiveClosure(dm, p, PETSC_TRUE, &n, &cl));
+  return out;
+}
+
+}  // namespace
+
+Space::Space(core::DMH dm, DM serial, PetscSF migration, const SpaceOptions& opt,
+             const std::vector<EssentialBC>& bcs)
+    : dm_(std::move(dm)), degree_(opt.degree) {
+  if (degree_ != 1 && degree_ != 2) throw std::invalid_argument("degree must be 1 or 2");
+  MPI_Comm cm = comm();
+  PetscInt d;
+  HS_PETSC(DMGetDimension(dm_, &d));
+  dim_ = int(d);
+  n_nodes_ = degree_ == 1 ? dim_ + 1 : (dim_ + 1) * (dim_ + 2) / 2;
+
+  // Finite element with minimal symmetric rules (PETSc's default rules are 3-8x larger).
+  const int qdeg = opt.quadrature_degree > 0 ? opt.quadrature_degree : 2 * degree_ - 1;
+  const int fqdeg = opt.facet_quadrature_degree > 0 ? opt.facet_quadrature_degree : 2 * degree_ + 2;
+  HS_PETSC(PetscFECreateLagrange(cm, dim_, dim_, PETSC_TRUE, degree_, PETSC_DETERMINE, fe_.out()));
+  core::QuadH q, fq;
+  HS_PETSC(PetscDTSimplexQuadrature(dim_, qdeg, PETSCDTSIMPLEXQUAD_MINSYM, q.out()));
+  HS_PETSC(PetscDTSimplexQuadrature(dim_ - 1, fqdeg, PETSCDTSIMPLEXQUAD_MINSYM, fq.out()));
+  HS_PETSC(PetscFESetQuadrature(fe_, q));
+  HS_PETSC(PetscFESetFaceQuadrature(fe_, fq));
+  HS_PETSC(PetscObjectSetName((PetscObject)fe_.get(), "displacement"));
+  HS_PETSC(DMSetField(dm_, 0, nullptr, (PetscObject)fe_.get()));
+  HS_PETSC(DMCreateDS(dm_));
+  for (const auto& bc : bcs) {
+    DMLabel label;
+    HS_PETSC(DMGetLabel(dm_, bc.label.c_str(), &label));
+    if (!label) throw std::logic_error("essential label " + bc.label + " is missing");
+    const PetscInt one = 1;
+    HS_PETSC(DMAddBoundary(dm_, DM_BC_ESSENTIAL, bc.label.c_str(), label, 1, &one, 0,
+                           PetscInt(bc.components.size()), bc.components.data(),
+                           (void (*)(void))zero_value, nullptr, nullptr, nullptr));
+  }
+  HS_PETSC(DMPlexCreateClosureIndex(dm_, nullptr));
+
+  // Reference basis at the quadrature points (closure order = PETSc's dof order).
+  {
+    PetscInt qd, qnc, np;
+    const PetscReal *pts, *wts;
+    HS_PETSC(PetscQuadratureGetData(q, &qd, &qnc, &np, &pts, &wts));
+    n_qp_ = int(np);
+    qw_.assign(wts, wts + np);
+    qxi_.assign(pts, pts + np * dim_);
+    PetscTabulation T;
+    HS_PETSC(PetscFECreateTabulation(fe_, 1, np, pts, 1, &T));
+    const PetscInt nb = T->Nb, nc = T->Nc;
+    if (nb != n_nodes_ * dim_ || nc != dim_) throw std::logic_error("unexpected tabulation size");
+    N_.resize(std::size_t(np) * n_nodes_);
+    dN_.resize(std::size_t(np) * n_nodes_ * dim_);
+    for (int iq = 0; iq < n_qp_; ++iq)
+      for (int a = 0; a < n_nodes_; ++a) {
+        const PetscInt b = a * nc;  // component-0 function of node a, component 0
+        N_[iq * n_nodes_ + a] = T->T[0][(iq * nb + b) * nc + 0];
+        for (int k = 0; k < dim_; ++k)
+          dN_[(std::size_t(iq) * n_nodes_ + a) * dim_ + k] = T->T[1][((iq * nb + b) * nc + 0) * dim_ + k];
+      }
+    HS_PETSC(PetscTabulationDestroy(&T));
+  }
+  {
+    PetscInt qd, qnc, np;
+    const PetscReal *pts, *wts;
+    HS_PETSC(PetscQuadratureGetData(fq, &qd, &qnc, &np, &pts, &wts));
+    double wsum = 0;
+    for (PetscInt i = 0; i < np; ++i) wsum += wts[i];
+    for (PetscInt i = 0; i < np; ++i) {
+      fqw_.push_back(wts[i] / wsum);
+      double l0 = 1.0;
+      std::array<double, 3> bary{};
+      for (int k = 0; k < dim_ - 1; ++k) {
+        bary[k + 1] = 0.5 * (pts[i * (dim_ - 1) + k] + 1.0);
+        l0 -= bary[k + 1];
+      }
+      bary[0] = l0;
+      for (int k = 0; k < dim_; ++k) fbary_.push_back(bary[k]);
+    }
+  }
+
+  // Per-cell geometry and dof indices.
+  PetscSection ls, gs;
+  HS_PETSC(DMGetLocalSection(dm_, &ls));
+  HS_PETSC(DMGetGlobalSection(dm_, &gs));
+  HS_PETSC(DMPlexGetHeightStratum(dm_, 0, &c0_, &c1_));
+  const PetscInt nloc = c1_ - c0_;
+  invJ_.resize(std::size_t(nloc) * dim_ * dim_);
+  detJ_.resize(nloc);
+  v0_.resize(std::size_t(nloc) * dim_);
+  ldofs_.resize(std::size_t(nloc) * n_cell_dofs());
+  gdofs_.resize(std::size_t(nloc) * n_cell_dofs());
+  PetscInt p_start, p_end;
+  HS_PETSC(DMPlexGetChart(dm_, &p_start, &p_end));
+  for (PetscInt c = c0_; c < c1_; ++c) {
+    double v0[3], J[9], iJ[9], detJ;
+    HS_PETSC(DMPlexComputeCellGeometryAffineFEM(dm_, c, v0, J, iJ, &detJ));
+    if (!(detJ > 0)) throw std::logic_error("cell with det J <= 0 reached the space");
+    std::copy(iJ, iJ + dim_ * dim_, &invJ_[std::size_t(c - c0_) * dim_ * dim_]);
+    std::copy(v0, v0 + dim_, &v0_[std::size_t(c - c0_) * dim_]);
+    detJ_[c - c0_] = detJ;
+    PetscInt n, *cl = nullptr, k = 0;
+    HS_PETSC(DMPlexGetTransitiveClosure(dm_, c, PETSC_TRUE, &n, &cl));
+    PetscInt* ld = &ldofs_[std::size_t(c - c0_) * n_cell_dofs()];
+    for (PetscInt i = 0; i < n; ++i) {
+      PetscInt dof, off;
+      HS_PETSC(PetscSectionGetDof(ls, cl[2 * i], &dof));
+      HS_PETSC(PetscSectionGetOffset(ls, cl[2 * i], &off));
+      for (PetscInt j = 0; j < dof; ++j) {
+        if (k >= n_cell_dofs()) throw std::logic_error("closure has too many dofs");
+        ld[k++] = off + j;
+      }
+    }
+    HS_PETSC(DMPlexRestoreTransitiveClosure(dm_, c, PETSC_TRUE, &n, &cl));
+    if (k != n_cell_dofs()) throw std::logic_error("closure has too few dofs");
+    PetscInt ni, *idx = nullptr;
+    HS_PETSC(DMPlexGetClosureIndices(dm_, ls, gs, c, PETSC_TRUE, &ni, &idx, nullptr, nullptr));
+    if (ni != n_cell_dofs()) throw std::logic_error("closure index count mismatch");
+    std::copy(idx, idx + ni, &gdofs_[std::size_t(c - c0_) * n_cell_dofs()]);
+    HS_PETSC(DMPlexRestoreClosureIndices(dm_, ls, gs, c, PETSC_TRUE, &ni, &idx, nullptr, nullptr));
+  }
+  long long nc_loc = nloc;
+  MPI_Allreduce(MPI_IN_PLACE, &nc_loc, 1, MPI_LONG_LONG, MPI_SUM, cm);
+  n_cells_global_ = nc_loc;
+  {
+    Vec g;
+    PetscInt n;
+    HS_PETSC(DMGetGlobalVector(dm_, &g));
+    HS_PETSC(VecGetSize(g, &n));
+    HS_PETSC(DMRestoreGlobalVector(dm_, &g));
+    n_dofs_global_ = n;
+  }
+
+  // Coordinates.
+  Vec coords;
+  PetscSection cs;
+  const PetscScalar* xa;
+  HS_PETSC(DMGetCoordinatesLocal(dm_, &coords));
+  HS_PETSC(DMGetCoordinateSection(dm_, &cs));
+  HS_PETSC(VecGetArrayRead(coords, &xa));
+
+  // Neumann facets: boundary facets carrying none of the essential labels.
+  {
+    std::vector<DMLabel> ess;
+    for (const auto& bc : bcs) {
+      DMLabel l;
+      HS_PETSC(DMGetLabel(dm_, bc.label.c_str(), &l));
+      ess.push_back(l);
+    }
+    PetscInt v0, v1;
+    HS_PETSC(DMPlexGetDepthStratum(dm_, 0, &v0, &v1));
+    IS facets = nullptr;
+    HS_PETSC(DMGetStratumIS(dm_, mesh::boundary_label, 1, &facets));
+    PetscInt nf = 0;
+    const PetscInt* fp = nullptr;
+    if (facets) {
+      HS_PETSC(ISGetLocalSize(facets, &nf));
+      HS_PETSC(ISGetIndices(facets, &fp));
+    }
+    for (PetscInt i = 0; i < nf; ++i) {
+      const PetscInt f = fp[i];
+      bool constrained = false;
+      for (DMLabel l : ess) {
+        PetscInt val;
+        HS_PETSC(DMLabelGetValue(l, f, &val));
+        constrained = constrained || val == 1;
+      }
+      if (constrained) continue;
+      FacetView fv{};
+      fv.point = f;
+      auto verts = closure_of_depth(dm_, f, v0, v1);
+      fv.n_vertices = int(verts.size());
+      for (int a = 0; a < fv.n_vertices; ++a) fv.x[a] = vertex_coords(cs, xa, verts[a], dim_);
+      PetscInt n, *cl = nullptr;
+      HS_PETSC(DMPlexGetTransitiveClosure(dm_, f, PETSC_TRUE, &n, &cl));
+      fv.n_nodes = 0;
+      for (PetscInt j = 0; j < n; ++j) {
+        const PetscInt p = cl[2 * j];
+        PetscInt dof, off;
+        HS_PETSC(PetscSectionGetDof(ls, p, &dof));
+        if (dof == 0) continue;
+        HS_PETSC(PetscSectionGetOffset(ls, p, &off));
+        std::array<int, 2> ends{};
+        if (p >= v0 && p < v1) {
+          const int a = int(std::find(verts.begin(), verts.end(), p) - verts.begin());
+          ends = {a, a};
+        } else {
+          const PetscInt* cone;
+          HS_PETSC(DMPlexGetCone(dm_, p, &cone));
+          ends = {int(std::find(verts.begin(), verts.end(), cone[0]) - verts.begin()),
+                  int(std::find(verts.begin(), verts.end(), cone[1]) - verts.begin())};
+        }
+        fv.offset[fv.n_nodes] = off;
+        fv.ends[fv.n_nodes] = ends;
+        ++fv.n_nodes;
+      }
+      HS_PETSC(DMPlexRestoreTransitiveClosure(dm_, f, PETSC_TRUE, &n, &cl));
+      neumann_facets_.push_back(fv);
+    }
+    if (facets) {
+      HS_PETSC(ISRestoreIndices(facets, &fp));
+      HS_PETSC(ISDestroy(&facets));
+    }
+  }
+
+  // Canonical numbering: vertices of the serial plex in order, then (P2) its edges in order.
+  const bool root = core::rank(cm) == 0;
+  PetscInt strata[4] = {0, 0, 0, 0};  // serial vStart, vEnd, eStart, eEnd
+  if (root) {
+    HS_PETSC(DMPlexGetDepthStratum(serial, 0, &strata[0], &strata[1]));
+    HS_PETSC(DMPlexGetDepthStratum(serial, 1, &strata[2], &strata[3]));
+  }
+  MPI_Bcast(strata, 4, MPIU_INT, 0, cm);
+  n_vertices_global_ = strata[1] - strata[0];
+  n_nodes_global_ = n_vertices_global_ + (degree_ == 2 ? strata[3] - strata[2] : 0);
+  std::vector<PetscInt> original(std::size_t(p_end - p_start));
+  if (migration) {
+    PetscInt s0 = 0, s1 = 0;
+    HS_PETSC(DMPlexGetChart(serial, &s0, &s1));
+    std::vector<PetscInt> identity(std::size_t(s1 - s0));
+    for (PetscInt p = s0; p < s1; ++p) identity[p - s0] = p;
+    HS_PETSC(PetscSFBcastBegin(migration, MPIU_INT, identity.data(), original.data(), MPI_REPLACE));
+    HS_PETSC(PetscSFBcastEnd(migration, MPIU_INT, identity.data(), original.data(), MPI_REPLACE));
+  } else {
+    for (PetscInt p = p_start; p < p_end; ++p) original[p - p_start] = p;
+  }
+  auto canonical = [&](PetscInt orig) -> std::int64_t {
+    if (orig >= strata[0] && orig < strata[1]) return orig - strata[0];
+    return n_vertices_global_ + (orig - strata[2]);
+  };
+  {
+    PetscSF point_sf;
+    HS_PETSC(DMGetPointSF(dm_, &point_sf));
+    PetscInt n_roots, n_leaves;
+    const PetscInt* leaves;
+    HS_PETSC(PetscSFGetGraph(point_sf, &n_roots, &n_leaves, &leaves, nullptr));
+    std::vector<char> ghost(std::size_t(p_end - p_start), 0);
+    for (PetscInt i = 0; i < n_leaves && n_leaves > 0; ++i)
+      ghost[(leaves ? leaves[i] : i) - p_start] = 1;
+    for (PetscInt p = p_start; p < p_end; ++p) {
+      PetscInt dof, off;
+      HS_PETSC(PetscSectionGetDof(ls, p, &dof));
+      if (dof == 0 || ghost[p - p_start]) continue;
+      HS_PETSC(PetscSectionGetOffset(ls, p, &off));
+      owned_nodes_.push_back({off, canonical(original[p - p_start]), node_coords(dm_, cs, xa, p, dim_)});
+    }
+  }
+  HS_PETSC(VecRestoreArrayRead(coords, &xa));
+
+  // Canonical connectivity and coordinates for output, from the serial plex (rank 0).
+  if (root) {
+    Vec sc;
+    PetscSection scs;
+    const PetscScalar* sxa;
+    HS_PETSC(DMGetCoordinatesLocal(serial, &sc));
+    HS_PETSC(DMGetCoordinateSection(serial, &scs));
+    HS_PETSC(VecGetArrayRead(sc, &sxa));
+    canonical_coords_.resize(std::size_t(n_nodes_global_) * dim_);
+    for (PetscInt p = strata[0]; p < strata[1]; ++p) {
+      auto x = vertex_coords(scs, sxa, p, dim_);
+      std::copy(x.begin(), x.begin() + dim_, &canonical_coords_[std::size_t(p - strata[0]) * dim_]);
+    }
+    if (degree_ == 2)
+      for (PetscInt p = strata[2]; p < strata[3]; ++p) {
+        auto x = node_coords(serial, scs, sxa, p, dim_);
+        std::copy(x.begin(), x.begin() + dim_, &canonical_coords_[std::size_t(canonical(p)) * dim_]);
+      }
+    PetscInt sc0, sc1;
+    HS_PETSC(DMPlexGetHeightStratum(serial, 0, &sc0, &sc1));
+    static const int tri_edges[3][2] = {{0, 1}, {1, 2}, {2, 0}};
+    static const int tet_edges[6][2] = {{0, 1}, {1, 2}, {0, 2}, {0, 3}, {1, 3}, {2, 3}};
+    for (PetscInt c = sc0; c < sc1; ++c) {
+      auto v = closure_of_depth(serial, c, strata[0], strata[1]);
+      if (dim_ == 3) std::swap(v[1], v[2]);  // PETSc's left-handed tetrahedra -> VTK's
+      for (auto p : v) canonical_cells_.push_back(canonical(p));
+      if (degree_ == 2) {
+        const int ne = dim_ == 2 ? 3 : 6;
+        for (int e = 0; e < ne; ++e) {
+          const int* ab = dim_ == 2 ? tri_edges[e] : tet_edges[e];
+          const PetscInt pair[2] = {v[ab[0]], v[ab[1]]};
+          PetscInt nj;
+          const PetscInt* join;
+          HS_PETSC(DMPlexGetJoin(serial, 2, pair, &nj, &join));
+          canonical_cells_.push_back(canonical(join[0]));
+          HS_PETSC(DMPlexRestoreJoin(serial, 2, pair, &nj, &join));
+        }
+      }
+    }
+    HS_PETSC(VecRestoreArrayRead(sc, &sxa));
+  }
+}
+
+void Space::map_point(PetscInt c, int q, double* x) const {
+  // x = v0 + J (xi + 1), J = inverse of invJ.
+  const double* iJ = inv_jacobian(c);
+  const double* v0 = &v0_[std::size_t(c - c0_) * dim_];
+  const double* xi = &qxi_[std::size_t(q) * dim_];
+  if (dim_ == 2) {
+    Eigen::Map<const Eigen::Matrix<double, 2, 2, Eigen::RowMajor>> m(iJ);
+    Eigen::Vector2d r = m.inverse() * Eigen::Vector2d(xi[0] + 1, xi[1] + 1);
+    x[0] = v0[0] + r[0];
+    x[1] = v0[1] + r[1];
+  } else {
+    Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> m(iJ);
+    Eigen::Vector3d r = m.inverse() * Eigen::Vector3d(xi[0] + 1, xi[1] + 1, xi[2] + 1);
+    for (int k = 0; k < 3; ++k) x[k] = v0[k] + r[k];
+  }
+}
+
+double Space::facet_basis(const std::array<int, 2>& ends, const double* bary) const {
+  const double la = bary[ends[0]];
+  if (ends[0] == ends[1]) return degree_ == 1 ? la : la * (2.0 * la - 1.0);
+  return 4.0 * la * bary[ends[1]];
+}
+
+double Space::facet_measure(const FacetView& f, int dim) {
+  const auto &a = f.x[0], &b = f.x[1];
+  if (dim == 2) return std::hypot(b[0] - a[0], b[1] - a[1]);
+  const auto& c = f.x[2];
+  const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+  const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+  const double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+  return 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+}
+
+double Space::min_det_jacobian() const {
+  double m = detJ_.empty() ? 1e300 : *std::min_element(detJ_.begin(), detJ_.end());
+  MPI_Allreduce(MPI_IN_PLACE, &m, 1, MPI_DOUBLE, MPI_MIN, comm());
+  return m;
+}
+
+}  // namespace hypershape::physics
