@@ -1,1 +1,93 @@
-int main(){return 0;}
+/// hypershape: the command-line entry point.
+///
+///   hypershape solve [SCENE.yaml] -o OUT.h5     one scene (default: the embedded one)
+///   hypershape effects                          lists the effects a scene may use
+///
+/// PETSc options (-snes_monitor, -pc_type ..., -log_view) pass through to PETSc.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+
+#include "hypershape/config/scene.hpp"
+#include "hypershape/core/error.hpp"
+#include "hypershape/core/log.hpp"
+#include "hypershape/core/petsc_handle.hpp"
+#include "hypershape/factory/solve_scene.hpp"
+#include "hypershape/physics/registry.hpp"
+
+using namespace hypershape;
+
+namespace {
+
+/// Checks that OUT can be created, before any work (nothing is written here).
+void check_output_path(const std::string& out) {
+  namespace fs = std::filesystem;
+  fs::path p(out);
+  if (p.extension() != ".h5") throw core::InputError("", "-o", "output must end in .h5, got '" + out + "'");
+  fs::path dir = p.parent_path().empty() ? fs::path(".") : p.parent_path();
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) throw core::InputError("", "-o", "directory does not exist: " + dir.string());
+  if (access(dir.c_str(), W_OK) != 0) throw core::InputError("", "-o", "directory is not writable: " + dir.string());
+}
+
+int run(int argc, char** argv) {
+  MPI_Comm comm = PETSC_COMM_WORLD;
+  const int rank = core::rank(comm);
+  CLI::App app{"hypershape: hyperelastic finite-element data factory"};
+  app.allow_extras();  // PETSc options
+  app.require_subcommand(1);
+  bool quiet = false;
+  app.add_flag("-q,--quiet", quiet, "print only errors");
+
+  auto* solve = app.add_subcommand("solve", "solve one scene and write it to HDF5 + XDMF");
+  std::string scene_path, out = "solution.h5";
+  solve->add_option("scene", scene_path, "scene file (YAML); default: the embedded default scene");
+  solve->add_option("-o,--output", out, "output file (.h5); an .xdmf file is written beside it");
+  solve->allow_extras();
+  auto* effects = app.add_subcommand("effects", "list the effects a scene may use");
+  effects->allow_extras();
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (rank == 0) app.exit(e);
+    return e.get_exit_code() == 0 ? 0 : 2;
+  }
+  core::set_verbosity(quiet ? core::Verbosity::quiet : core::Verbosity::normal);
+
+  if (*effects) {
+    for (auto& [name, help] : physics::registered_effects()) core::info(comm, "{:20s} {}", name, help);
+    return 0;
+  }
+  // Validate everything that can be validated before any work or output.
+  check_output_path(out);
+  config::Scene scene = scene_path.empty()
+                            ? config::parse_scene_text(config::default_scene_text(), "<default scene>")
+                            : config::parse_scene_file(scene_path);
+  auto outcome = factory::solve_scene(comm, scene);
+  auto t0 = core::now_seconds();
+  if (rank == 0) io::write_solution(out, outcome.record);
+  outcome.times.add("write", core::now_seconds() - t0);
+  core::info(comm, "{} -> {}", factory::summary_line(outcome), out);
+  return outcome.converged ? 0 : 3;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  core::PetscSession session(&argc, &argv, "hypershape: see `hypershape --help`\n");
+  int code = 1;
+  try {
+    code = run(argc, argv);
+  } catch (const core::InputError& e) {
+    // Input errors are raised on every rank alike: report once.
+    if (core::rank(PETSC_COMM_WORLD) == 0) std::fprintf(stderr, "error: %s\n", e.what());
+    code = 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "[rank %d] error: %s\n", core::rank(PETSC_COMM_WORLD), e.what());
+    code = 1;
+  }
+  return code;
+}

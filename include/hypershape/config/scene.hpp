@@ -1,0 +1,59 @@
+#pragma once
+/// A scene file fixes every choice of one solve: base shape, mesh, effects, load, solver.
+///
+/// ```yaml
+/// geometry: {base: circle}            # circle (2D) | sphere (3D) | file (+ file: PATH.msh)
+/// mesh: {h: 0.05, degree: 1, clamp_refinement: 0.25}
+/// effects:
+///   neo_hookean: {E: 500, nu: 0.49}
+///   dirichlet_patch: {center: [1, 0], radius: 0.5}
+///   gaussian_traction: {center: [-1, 0], direction: [0, 1], gamma: 0.2}
+/// load: {target: 0.3}                 # or {alpha: 10}
+/// solver: {rtol: 1e-9, max_newton: 12, target_rtol: 1e-3}
+/// petsc: {snes_monitor: ""}           # any PETSc options, without the leading dash
+/// ```
+/// Every key is checked: unknown keys, wrong types and out-of-range values throw
+/// core::InputError naming the file and the key path.
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "hypershape/core/params.hpp"
+#include "hypershape/physics/space.hpp"
+#include "hypershape/solver/nonlinear.hpp"
+
+namespace hypershape::config {
+
+/// A block of effect parameters that remembers which keys were read.
+class EffectParams : public core::Params {
+ public:
+  virtual ~EffectParams() = default;
+  /// Throws InputError for any key that was never read (an unknown key).
+  virtual void check_all_used() const = 0;
+};
+
+struct Scene {
+  std::string source;      ///< file name, or "<default scene>"
+  std::string text;        ///< the YAML as read (stored with the results)
+  std::string base;        ///< circle | sphere | file
+  std::string mesh_file;   ///< resolved path when base == file
+  int dim = 2;             ///< 0 until known for base == file
+  double h = 0.05;
+  int degree = 1;
+  double clamp_refinement = 0.25;
+  std::vector<std::pair<std::string, std::shared_ptr<EffectParams>>> effects;  ///< in file order
+  std::optional<double> alpha, target;
+  solver::SolverOptions solver;
+  std::vector<std::pair<std::string, std::string>> petsc;  ///< option (with dash), value
+};
+
+/// Parses and validates a scene (everything but the effects' own keys, which are checked when
+/// the effects are built). Throws core::InputError.
+Scene parse_scene_file(const std::string& path);
+Scene parse_scene_text(const std::string& text, const std::string& source, const std::string& base_dir = ".");
+/// The embedded default scene: the seed paper's set-up on the unit disk.
+const char* default_scene_text();
+
+}  // namespace hypershape::config

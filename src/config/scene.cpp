@@ -1,0 +1,246 @@
+#include "hypershape/config/scene.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "hypershape/core/error.hpp"
+
+namespace hypershape::config {
+
+namespace {
+
+using core::InputError;
+
+std::string join(const std::string& a, const std::string& b) {
+  return a.empty() ? b : b.empty() ? a : a + "." + b;
+}
+
+/// Key checks for one YAML mapping.
+class Block {
+ public:
+  Block(const YAML::Node& node, std::string file, std::string path)
+      : node_(node), file_(std::move(file)), path_(std::move(path)) {
+    if (node_ && !node_.IsNull() && !node_.IsMap())
+      throw InputError(file_, path_, "must be a mapping of keys to values");
+  }
+  [[noreturn]] void fail(const std::string& key, const std::string& msg) const {
+    throw InputError(file_, join(path_, key), msg);
+  }
+  bool has(const std::string& key) const {
+    used_.insert(key);
+    return node_ && node_.IsMap() && node_[key] && !node_[key].IsNull();
+  }
+  YAML::Node get(const std::string& key) const {
+    used_.insert(key);
+    return node_ && node_.IsMap() ? node_[key] : YAML::Node();
+  }
+  double number(const std::string& key) const {
+    auto n = get(key);
+    if (!n || n.IsNull()) fail(key, "missing (a number is required)");
+    if (!n.IsScalar()) fail(key, "must be a number");
+    double v;
+    try {
+      v = n.as<double>();
+    } catch (const YAML::Exception&) {
+      fail(key, "must be a number, got '" + n.Scalar() + "'");
+    }
+    if (!std::isfinite(v)) fail(key, "must be a finite number");
+    return v;
+  }
+  long integer(const std::string& key) const {
+    const double v = number(key);
+    if (v != std::floor(v)) fail(key, "must be an integer");
+    return long(v);
+  }
+  std::string text(const std::string& key) const {
+    auto n = get(key);
+    if (!n || n.IsNull()) fail(key, "missing (a string is required)");
+    if (!n.IsScalar()) fail(key, "must be a string");
+    return n.Scalar();
+  }
+  std::vector<double> vector(const std::string& key, std::size_t n) const {
+    auto v = get(key);
+    if (!v || v.IsNull()) fail(key, "missing (a list of " + std::to_string(n) + " numbers is required)");
+    if (!v.IsSequence() || v.size() != n)
+      fail(key, "must be a list of " + std::to_string(n) + " numbers");
+    std::vector<double> out;
+    for (const auto& e : v) {
+      double x;
+      try {
+        x = e.as<double>();
+      } catch (const YAML::Exception&) {
+        fail(key, "must be a list of " + std::to_string(n) + " numbers");
+      }
+      if (!std::isfinite(x)) fail(key, "must hold finite numbers");
+      out.push_back(x);
+    }
+    return out;
+  }
+  void check_all_used() const {
+    if (!node_ || !node_.IsMap()) return;
+    for (const auto& kv : node_) {
+      const auto k = kv.first.Scalar();
+      if (!used_.count(k)) fail(k, "unknown key" + (allowed_.empty() ? "" : "; allowed: " + allowed_));
+    }
+  }
+  void allowed(std::string a) { allowed_ = std::move(a); }
+  const YAML::Node& node() const { return node_; }
+
+ private:
+  YAML::Node node_;
+  std::string file_, path_, allowed_;
+  mutable std::set<std::string> used_;
+};
+
+class YamlEffectParams : public EffectParams {
+ public:
+  YamlEffectParams(const YAML::Node& node, const std::string& file, const std::string& path)
+      : block_(node, file, path) {}
+  bool has(const std::string& key) const override { return block_.has(key); }
+  double number(const std::string& key) const override { return block_.number(key); }
+  std::vector<double> vector(const std::string& key, std::size_t n) const override {
+    return block_.vector(key, n);
+  }
+  std::string text(const std::string& key) const override { return block_.text(key); }
+  [[noreturn]] void fail(const std::string& key, const std::string& message) const override {
+    block_.fail(key, message);
+  }
+  void check_all_used() const override { block_.check_all_used(); }
+
+ private:
+  Block block_;
+};
+
+}  // namespace
+
+const char* default_scene_text() {
+  return R"(# The default scene: the seed paper's set-up (section 3.2, appendix A) on the unit disk.
+geometry: {base: circle}
+mesh: {h: 0.05, degree: 1, clamp_refinement: 0.25}
+effects:
+  neo_hookean: {E: 500, nu: 0.49}
+  dirichlet_patch: {center: [1.0, 0.0], radius: 0.5}
+  gaussian_traction: {center: [-1.0, 0.0], direction: [0.0, 1.0], gamma: 0.2}
+load: {target: 0.3}
+)";
+}
+
+Scene parse_scene_text(const std::string& text, const std::string& source, const std::string& base_dir) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw InputError(source, "", std::string("not valid YAML: ") + e.what());
+  }
+  if (!root || !root.IsMap()) throw InputError(source, "", "a scene must be a YAML mapping");
+  Scene s;
+  s.source = source;
+  s.text = text;
+  Block top(root, source, "");
+  top.allowed("geometry, mesh, effects, load, solver, petsc");
+  for (const auto& kv : root) {
+    static const std::set<std::string> sections = {"geometry", "mesh", "effects", "load", "solver", "petsc"};
+    if (!sections.count(kv.first.Scalar()))
+      top.fail(kv.first.Scalar(), "unknown key; allowed: geometry, mesh, effects, load, solver, petsc");
+  }
+
+  Block geo(top.get("geometry"), source, "geometry");
+  if (!top.has("geometry")) top.fail("geometry", "missing (e.g. geometry: {base: circle})");
+  s.base = geo.text("base");
+  if (s.base == "circle") {
+    s.dim = 2;
+  } else if (s.base == "sphere") {
+    s.dim = 3;
+  } else if (s.base == "file") {
+    namespace fs = std::filesystem;
+    fs::path p = geo.text("file");
+    if (p.is_relative()) p = fs::path(base_dir) / p;
+    std::error_code ec;
+    if (!fs::is_regular_file(p, ec)) geo.fail("file", "no such mesh file: " + p.string());
+    s.mesh_file = p.string();
+    s.dim = 0;
+  } else {
+    geo.fail("base", "unknown base shape '" + s.base + "'; allowed: circle, sphere, file");
+  }
+  geo.allowed("base, file");
+  geo.check_all_used();
+
+  Block mesh(top.get("mesh"), source, "mesh");
+  if (mesh.has("h")) {
+    s.h = mesh.number("h");
+    if (!(s.h > 0 && s.h <= 1)) mesh.fail("h", "must be in (0, 1]");
+  }
+  if (mesh.has("degree")) {
+    s.degree = int(mesh.integer("degree"));
+    if (s.degree != 1 && s.degree != 2) mesh.fail("degree", "must be 1 or 2");
+  }
+  if (mesh.has("clamp_refinement")) {
+    s.clamp_refinement = mesh.number("clamp_refinement");
+    if (!(s.clamp_refinement > 0 && s.clamp_refinement <= 1))
+      mesh.fail("clamp_refinement", "must be in (0, 1] (element size at the patch ends / h)");
+  }
+  mesh.allowed("h, degree, clamp_refinement");
+  mesh.check_all_used();
+
+  if (!top.has("effects")) top.fail("effects", "missing (a mapping of effect names to parameters)");
+  Block eff(top.get("effects"), source, "effects");
+  for (const auto& kv : eff.node()) {
+    const std::string name = kv.first.Scalar();
+    eff.get(name);  // mark used; the registry checks the name when the effect is built
+    s.effects.emplace_back(name, std::make_shared<YamlEffectParams>(kv.second, source, "effects." + name));
+  }
+  if (s.effects.empty()) top.fail("effects", "must list at least one effect");
+
+  Block load(top.get("load"), source, "load");
+  if (!top.has("load")) top.fail("load", "missing (load: {target: 0.3} or load: {alpha: 10})");
+  if (load.has("alpha") == load.has("target")) load.fail("", "give exactly one of alpha, target");
+  if (load.has("alpha")) {
+    s.alpha = load.number("alpha");
+    if (!(*s.alpha >= 0)) load.fail("alpha", "must be >= 0");
+  } else {
+    s.target = load.number("target");
+    if (!(*s.target > 0 && *s.target <= 2)) load.fail("target", "must be in (0, 2]");
+  }
+  load.allowed("alpha, target");
+  load.check_all_used();
+
+  Block sol(top.get("solver"), source, "solver");
+  if (sol.has("rtol")) s.solver.rtol = sol.number("rtol");
+  if (!(s.solver.rtol > 0 && s.solver.rtol < 1)) sol.fail("rtol", "must be in (0, 1)");
+  if (sol.has("max_newton")) s.solver.max_newton = int(sol.integer("max_newton"));
+  if (s.solver.max_newton < 1) sol.fail("max_newton", "must be >= 1");
+  if (sol.has("max_increments")) s.solver.max_increments = int(sol.integer("max_increments"));
+  if (s.solver.max_increments < 1) sol.fail("max_increments", "must be >= 1");
+  if (sol.has("target_rtol")) s.solver.target_rtol = sol.number("target_rtol");
+  if (!(s.solver.target_rtol > 0 && s.solver.target_rtol < 1)) sol.fail("target_rtol", "must be in (0, 1)");
+  sol.allowed("rtol, max_newton, max_increments, target_rtol");
+  sol.check_all_used();
+
+  Block petsc(top.get("petsc"), source, "petsc");
+  if (petsc.node() && petsc.node().IsMap())
+    for (const auto& kv : petsc.node()) {
+      const std::string k = kv.first.Scalar();
+      petsc.get(k);
+      if (!kv.second.IsNull() && !kv.second.IsScalar()) petsc.fail(k, "must be a scalar value");
+      s.petsc.emplace_back("-" + k, kv.second.IsNull() ? "" : kv.second.Scalar());
+    }
+  top.check_all_used();
+  return s;
+}
+
+Scene parse_scene_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path, "", "cannot open the scene file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parse_scene_text(ss.str(), path, std::filesystem::path(path).parent_path().string().empty()
+                                              ? "."
+                                              : std::filesystem::path(path).parent_path().string());
+}
+
+}  // namespace hypershape::config

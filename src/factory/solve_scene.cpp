@@ -1,0 +1,152 @@
+#include "hypershape/factory/solve_scene.hpp"
+
+#include <fmt/format.h>
+#include <petscsys.h>
+
+#include <algorithm>
+#include <optional>
+
+#include "hypershape/core/collective.hpp"
+#include "hypershape/core/error.hpp"
+#include "hypershape/mesh/gmsh_mesher.hpp"
+#include "hypershape/physics/problem.hpp"
+#include "hypershape/physics/registry.hpp"
+#include "hypershape/solver/nonlinear.hpp"
+
+namespace hypershape::factory {
+
+namespace {
+
+/// The clamp the mesher must conform to: the scene's dirichlet_patch, if any.
+std::optional<mesh::ClampRegion> clamp_of(const config::Scene& s) {
+  for (auto& [name, p] : s.effects)
+    if (name == "dirichlet_patch") {
+      mesh::ClampRegion c;
+      auto v = p->vector("center", std::size_t(s.dim));
+      std::copy(v.begin(), v.end(), c.center.begin());
+      c.radius = p->number("radius");
+      return c;
+    }
+  return std::nullopt;
+}
+
+}  // namespace
+
+SceneOutcome solve_scene(MPI_Comm comm, const config::Scene& scene_in) {
+  SceneOutcome o;
+  config::Scene scene = scene_in;
+  mesh::MeshData m;
+  {
+    auto t = o.times.scope("mesh");
+    // For a mesh file the dimension comes from the file.
+    if (scene.base == "file") {
+      core::on_root(comm, [&] { m = mesh::read_mesh_file(scene.mesh_file); });
+      int d = m.dim;
+      MPI_Bcast(&d, 1, MPI_INT, 0, comm);
+      scene.dim = d;
+    }
+  }
+  // Build (and so validate) every effect before any mesh or solver work.
+  std::vector<physics::EffectPtr> effects;
+  bool has_energy = false, has_dirichlet = false;
+  for (auto& [name, params] : scene.effects) {
+    effects.push_back(physics::make_effect(name, *params, scene.dim));
+    params->check_all_used();
+    has_energy = has_energy || effects.back()->has_energy();
+    has_dirichlet = has_dirichlet || name.find("dirichlet") != std::string::npos;
+  }
+  if (!has_energy)
+    throw core::InputError(scene.source, "effects", "no material: add one, e.g. neo_hookean: {E: 500, nu: 0.49}");
+  if (!has_dirichlet)
+    throw core::InputError(scene.source, "effects",
+                           "no Dirichlet condition (e.g. dirichlet_patch): the problem would be singular");
+  for (auto& [k, v] : scene.petsc) {
+    PetscBool set;
+    HS_PETSC(PetscOptionsHasName(nullptr, nullptr, k.c_str(), &set));
+    if (!set) HS_PETSC(PetscOptionsSetValue(nullptr, k.c_str(), v.empty() ? nullptr : v.c_str()));
+  }
+  {
+    auto t = o.times.scope("mesh");
+    if (scene.base != "file") {
+      mesh::MeshOptions mo;
+      mo.h = scene.h;
+      mo.clamp_size = scene.h * scene.clamp_refinement;
+      auto clamp = clamp_of(scene);
+      core::on_root(comm, [&] { m = scene.dim == 2 ? mesh::mesh_disk(mo, clamp) : mesh::mesh_ball(mo, clamp); });
+    }
+  }
+  std::unique_ptr<physics::Problem> problem;
+  std::unique_ptr<solver::NonlinearSolver> nl;
+  {
+    auto t = o.times.scope("setup");
+    try {
+      problem = std::make_unique<physics::Problem>(comm, m, std::move(effects), physics::SpaceOptions{scene.degree});
+    } catch (core::InputError& e) {
+      throw core::InputError(scene.source, "", e.what());
+    }
+    nl = std::make_unique<solver::NonlinearSolver>(*problem, scene.solver);
+  }
+  {
+    auto t = o.times.scope("solve");
+    if (scene.target) {
+      auto r = nl->solve_for_target(*scene.target);
+      o.converged = r.converged;
+      o.reason = r.reason;
+      o.alpha = r.alpha;
+      o.newton_iterations = r.newton_iterations;
+      o.solves = r.solves;
+      o.failed_increments = r.failed_increments;
+    } else {
+      auto r = nl->solve(*scene.alpha);
+      o.converged = r.converged;
+      o.reason = r.reason;
+      o.alpha = r.load_factor;
+      o.newton_iterations = r.newton_iterations;
+      o.solves = 1;
+      o.failed_increments = r.failed_increments;
+    }
+    o.max_displacement = problem->max_displacement(nl->solution());
+    o.min_det_f = problem->min_det_f(nl->solution());
+  }
+  const auto& sp = problem->space();
+  o.dim = sp.dim();
+  o.degree = sp.degree();
+  o.n_vertices = sp.n_vertices_global();
+  o.n_cells = sp.n_cells_global();
+  o.n_dofs = sp.n_dofs_global();
+  {
+    auto t = o.times.scope("gather");
+    auto field = problem->gather(nl->solution());
+    if (core::rank(comm) == 0) {
+      auto& r = o.record;
+      r.dim = o.dim;
+      r.degree = o.degree;
+      r.n_vertices = o.n_vertices;
+      r.nodes = sp.canonical_coords();
+      r.cells = sp.canonical_cells();
+      r.displacement = std::move(field.values);
+      r.scene_text = scene.text;
+      r.numbers = {{"alpha", o.alpha},
+                   {"max_displacement", o.max_displacement},
+                   {"min_det_F", o.min_det_f},
+                   {"converged", o.converged ? 1.0 : 0.0},
+                   {"newton_iterations", double(o.newton_iterations)}};
+      if (scene.target) r.numbers["target"] = *scene.target;
+      r.strings = {{"reason", o.reason}, {"source", scene.source}};
+    }
+  }
+  return o;
+}
+
+std::string summary_line(const SceneOutcome& o) {
+  std::string times;
+  for (auto& [k, v] : o.times.all()) times += fmt::format(" {} {:.3f}s", k, v);
+  return fmt::format("{}D P{}: {} vertices, {} cells, {} dofs | {} | alpha {:.6g}, max|u| {:.6g}, min det F {:.3f} | "
+                     "{} Newton iterations in {} solves ({} failed increments) |{}",
+                     o.dim, o.degree, o.n_vertices, o.n_cells, o.n_dofs,
+                     o.converged ? "converged" : "NOT converged: " + o.reason, o.alpha,
+                     o.max_displacement, o.min_det_f, o.newton_iterations, o.solves,
+                     o.failed_increments, times);
+}
+
+}  // namespace hypershape::factory

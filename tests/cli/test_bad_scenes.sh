@@ -1,0 +1,58 @@
+#!/usr/bin/env bash
+# Bad scene files fail with a message naming the file and the key, a non-zero exit, and no
+# output file. Needs HYPERSHAPE_BIN (set by CTest).
+set -u
+bin=${HYPERSHAPE_BIN:?}
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fails=0 passes=0
+
+good() {
+  cat <<'YAML'
+geometry: {base: circle}
+mesh: {h: 0.1, degree: 1}
+effects:
+  neo_hookean: {E: 500, nu: 0.49}
+  dirichlet_patch: {center: [1.0, 0.0], radius: 0.5}
+  gaussian_traction: {center: [-1.0, 0.0], direction: [0.0, 1.0], gamma: 0.2}
+load: {target: 0.3}
+YAML
+}
+
+# expect NAME SED-EXPRESSION EXPECTED-KEY-TEXT
+expect() {
+  local name=$1 expr=$2 key=$3 scene="$work/$1.yaml" out="$work/$1.h5"
+  good | sed -e "$expr" > "$scene"
+  local msg code
+  msg=$("$bin" solve "$scene" -o "$out" 2>&1 >/dev/null); code=$?
+  if [ "$code" -eq 0 ]; then echo "FAIL $name: exit 0"; fails=$((fails+1)); return; fi
+  if ! grep -qF "$scene" <<<"$msg"; then echo "FAIL $name: message does not name the file: $msg"; fails=$((fails+1)); return; fi
+  if ! grep -qF "$key" <<<"$msg"; then echo "FAIL $name: message does not name '$key': $msg"; fails=$((fails+1)); return; fi
+  if ls "$work/$1".h5* "$work/$1".xdmf* >/dev/null 2>&1; then echo "FAIL $name: output left behind"; fails=$((fails+1)); return; fi
+  echo "ok   $name: $msg"; passes=$((passes+1))
+}
+
+expect missing_load      '/^load:/d'                               'load'
+expect missing_material  '/neo_hookean/d'                          'effects'
+expect wrong_type_h      's/h: 0.1/h: fine/'                       'mesh.h'
+expect wrong_type_center 's/center: \[1.0, 0.0\]/center: 1.0/'     'effects.dirichlet_patch.center'
+expect nu_too_large      's/nu: 0.49/nu: 0.5/'                     'effects.neo_hookean.nu'
+expect negative_E        's/E: 500/E: -1/'                         'effects.neo_hookean.E'
+expect radius_zero       's/radius: 0.5/radius: 0/'                'effects.dirichlet_patch.radius'
+expect radius_negative   's/radius: 0.5/radius: -0.2/'             'effects.dirichlet_patch.radius'
+expect unknown_effect    's/gaussian_traction/gausian_traction/'   'effects.gausian_traction'
+expect unknown_key       's/gamma: 0.2/gamma: 0.2, sigma: 1/'      'effects.gaussian_traction.sigma'
+expect unknown_section   's/^load:/loads:/'                        'loads'
+expect unknown_mesh_file 's/{base: circle}/{base: file, file: nowhere.msh}/' 'geometry.file'
+expect unknown_base      's/base: circle/base: torus/'             'geometry.base'
+expect bad_degree        's/degree: 1/degree: 3/'                  'mesh.degree'
+expect alpha_and_target  's/{target: 0.3}/{target: 0.3, alpha: 2}/' 'load'
+expect not_yaml          's/^geometry: {base: circle}/geometry: {base: [circle/' 'YAML'
+
+# An unwritable output directory: rejected before any work.
+good > "$work/ok.yaml"
+if "$bin" solve "$work/ok.yaml" -o "$work/no/such/dir/out.h5" 2>/dev/null; then
+  echo "FAIL unwritable output accepted"; fails=$((fails+1)); else echo "ok   unwritable output"; passes=$((passes+1)); fi
+
+echo "$passes passed, $fails failed"
+[ "$fails" -eq 0 ]
