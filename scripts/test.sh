@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Sets up (packages, configure, build) and runs the whole test suite with CTest.
-# Slow tests carry the CTest label "slow" and run only with: scripts/test.sh -L slow
+# Slow tests carry the CTest label "slow" and run only with: scripts/test.sh -C slow -L slow
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh

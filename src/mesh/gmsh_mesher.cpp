@@ -39,14 +39,16 @@ class ScopedModel {
 /// Deterministic, quiet, serial meshing with the size given only by the background field.
 void set_common_options(double h) {
   gmsh::option::setNumber("General.Terminal", 0);
-  gmsh::option::setNumber("General.NumThreads", 1);  // determinism: same mesh on every rank
+  gmsh::option::setNumber("General.NumThreads", 1);  // determinism: same mesh on every run
   gmsh::option::setNumber("Mesh.MeshSizeMax", h);
   gmsh::option::setNumber("Mesh.MeshSizeMin", 0.0);
   gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
   gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
   gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", 0);
   gmsh::option::setNumber("Mesh.Algorithm", 6);     // Frontal-Delaunay (2D)
-  gmsh::option::setNumber("Mesh.Algorithm3D", 10);  // HXT: 2.5-5x faster than Delaunay here
+  // Delaunay, not HXT: HXT (faster, FACTS.md) gave a different mesh on each call, even with one
+  // thread (838/835/837 vertices for the same ball); datasets must be reproducible.
+  gmsh::option::setNumber("Mesh.Algorithm3D", 1);
   gmsh::option::setNumber("Mesh.Optimize", 1);
   gmsh::option::setNumber("Mesh.ElementOrder", 1);
 }
