@@ -140,6 +140,17 @@ MeshData extract(int dim) {
   return m;
 }
 
+/// After gmsh throws inside open() it stays locked ("I'm busy!") and keeps its last error:
+/// restart it so later meshing works.
+void restart_gmsh() {
+  try {
+    gmsh::finalize();
+  } catch (...) {
+  }
+  gmsh::initialize(0, nullptr, false);
+  gmsh::option::setNumber("General.Terminal", 0);
+}
+
 std::string last_gmsh_error() {
   std::string err;
   try {
@@ -226,7 +237,9 @@ MeshData mesh_disk(const MeshOptions& opt, const std::optional<ClampRegion>& cla
     gmsh::model::geo::synchronize();
     set_clamp_size_field(opt, 0, clamp_points);
     gmsh::model::mesh::generate(2);
-    return extract(2);
+    MeshData m = extract(2);
+    if (m.n_cells() == 0) throw std::runtime_error("gmsh produced no triangles for the disk");
+    return m;
   });
 }
 
@@ -285,7 +298,9 @@ MeshData mesh_ball(const MeshOptions& opt, const std::optional<ClampRegion>& cla
     gmsh::model::occ::synchronize();
     set_clamp_size_field(opt, 1, clamp_curves);
     gmsh::model::mesh::generate(3);
-    return extract(3);
+    MeshData m = extract(3);
+    if (m.n_cells() == 0) throw std::runtime_error("gmsh produced no tetrahedra for the ball");
+    return m;
   });
 }
 
@@ -311,13 +326,18 @@ MeshData read_mesh_file(const std::string& path) {
     throw core::InputError(path, "", "mesh file does not exist or is not a regular file");
   ScopedModel model("file");
   gmsh::option::setNumber("General.Terminal", 0);
+  // gmsh keeps its last error across calls: only a new one speaks about this file.
+  const std::string error_before = last_gmsh_error();
   try {
     gmsh::open(path);
   } catch (const std::string& s) {
+    restart_gmsh();
     throw core::InputError(path, "", "gmsh could not read the mesh: " + s);
   }
-  if (auto err = last_gmsh_error(); !err.empty() && err.find("rror") != std::string::npos)
+  if (auto err = last_gmsh_error(); err != error_before && err.find("rror") != std::string::npos) {
+    restart_gmsh();
     throw core::InputError(path, "", "gmsh could not read the mesh: " + err);
+  }
   const int dim = gmsh::model::getDimension();
   if (dim != 2 && dim != 3)
     throw core::InputError(path, "", "the file holds no 2D or 3D mesh (dimension " +

@@ -35,7 +35,8 @@ NonlinearSolver::NonlinearSolver(const physics::Problem& problem, const SolverOp
   r_ = problem.create_vector();
   HS_PETSC(SNESCreate(comm, snes_.out()));
   if (!prefix.empty()) HS_PETSC(SNESSetOptionsPrefix(snes_, prefix.c_str()));
-  HS_PETSC(SNESSetDM(snes_, problem.dm()));
+  // No SNESSetDM: SNES callbacks live on the DM's DMSNES, so solvers sharing the problem's DM
+  // would overwrite each other's context. We assemble ourselves; SNES keeps a private shell DM.
   HS_PETSC(SNESSetFunction(snes_, r_, form_function, this));
   HS_PETSC(SNESSetJacobian(snes_, J_, J_, form_jacobian, this));
   HS_PETSC(SNESSetType(snes_, SNESNEWTONLS));

@@ -1,0 +1,155 @@
+/// Hand-written element loops against PETSc's generic pointwise assembly (same quadrature, same
+/// kernel: they must agree to round-off), and the residual as the gradient of the energy.
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "support/helpers.hpp"
+
+using namespace hypershape;
+using hstest::on_plane;
+
+namespace {
+
+struct Case {
+  const char* name;
+  int dim;
+  int degree;
+};
+
+/// A small problem: the clamped disk with a Gaussian traction in 2D, a cube clamped on x = 0
+/// with a Gaussian traction near the opposite corner in 3D.
+std::unique_ptr<physics::Problem> make_problem(int dim, int degree) {
+  std::vector<physics::EffectPtr> effects;
+  effects.push_back(physics::make_neo_hookean(500.0, 0.3));
+  mesh::MeshData m;
+  if (dim == 2) {
+    m = hstest::disk_mesh(0.2);
+    effects.push_back(physics::make_dirichlet_patch({1.0, 0.0}, 0.5));
+    effects.push_back(physics::make_gaussian_traction({-1.0, 0.0}, {0.0, 1.0}, 0.2));
+  } else {
+    m = mesh::mesh_box(3, 1.0, degree == 1 ? 0.3 : 0.4);
+    effects.push_back(physics::make_dirichlet("clamp", on_plane(0, 0.0)));
+    effects.push_back(physics::make_gaussian_traction({1.0, 1.0, 1.0}, {0.0, 0.0, -1.0}, 0.3));
+  }
+  return std::make_unique<physics::Problem>(PETSC_COMM_WORLD, m, std::move(effects),
+                                            hstest::degree(degree));
+}
+
+/// A smooth, clearly non-linear displacement with gradients of order 0.1-0.3 that vanishes on
+/// the clamped boundary (so that zeroing the constrained dofs leaves it intact).
+void smooth_field(const double* x, double* u, int dim, double scale) {
+  // 2D: zero on the patch |x - (1, 0)| <= 0.5; 3D: zero on x = 0.
+  const double d2 = (x[0] - 1.0) * (x[0] - 1.0) + x[1] * x[1];
+  const double phi = dim == 2 ? std::max(0.0, d2 - 0.25) / 3.0 : x[0];
+  u[0] = scale * phi * (0.4 * std::sin(1.3 * x[0] + 0.4 * x[1]) + 0.15 * x[1] * x[1]);
+  u[1] = scale * phi * (0.3 * std::cos(0.9 * x[0] - 1.1 * x[1]) - 0.2 * x[0] * x[1]);
+  if (dim == 3) {
+    u[0] += scale * phi * 0.15 * x[2];
+    u[1] += scale * phi * 0.1 * std::sin(2.0 * x[2]);
+    u[2] = scale * phi * (0.3 * std::sin(x[0] + x[1] + x[2]) - 0.2 * x[2] * x[2]);
+  }
+}
+
+const Case cases[] = {{"2D P1", 2, 1}, {"2D P2", 2, 2}, {"3D P1", 3, 1}, {"3D P2", 3, 2}};
+
+}  // namespace
+
+TEST_CASE("Hand-written residual and tangent equal PETSc's pointwise assembly", "[assembly]") {
+  for (const Case& c : cases) {
+    DYNAMIC_SECTION(c.name) {
+      auto p = make_problem(c.dim, c.degree);
+      const int dim = c.dim;
+      core::VecH u = p->create_vector(), r = p->create_vector(), r_pw = p->create_vector();
+      hstest::interpolate(
+          *p, [dim](const double* x, double* v) { smooth_field(x, v, dim, 1.0); }, u);
+      const double jmin = p->min_det_f(u);
+      INFO("min det F = " << jmin);
+      REQUIRE(jmin > 0.3);
+      REQUIRE(jmin < 0.97);  // the state is really deformed
+
+      REQUIRE(p->residual(u, 0.0, r));
+      p->residual_pointwise(u, r_pw);
+      PetscReal rn;
+      HS_PETSC(VecNorm(r, NORM_2, &rn));
+      REQUIRE(rn > 1.0);  // E = 500 and strains ~0.1: far from zero
+      const double dr = hstest::rel_diff(r_pw, r);
+      INFO("residual: ||r|| = " << rn << ", relative difference " << dr);
+      CHECK(dr < 1e-12);
+
+      core::MatH J = p->create_matrix(), J_pw = p->create_matrix();
+      REQUIRE(p->jacobian(u, J));
+      p->jacobian_pointwise(u, J_pw);
+      PetscReal jn, dn;
+      HS_PETSC(MatNorm(J, NORM_FROBENIUS, &jn));
+      HS_PETSC(MatAXPY(J_pw, -1.0, J, DIFFERENT_NONZERO_PATTERN));
+      HS_PETSC(MatNorm(J_pw, NORM_FROBENIUS, &dn));
+      INFO("tangent: ||J||_F = " << jn << ", relative difference " << dn / jn);
+      REQUIRE(jn > 0);
+      CHECK(dn / jn < 1e-12);
+    }
+  }
+}
+
+TEST_CASE("The residual is the gradient of the potential energy", "[assembly]") {
+  for (const Case& c : cases) {
+    DYNAMIC_SECTION(c.name) {
+      auto p = make_problem(c.dim, c.degree);
+      const int dim = c.dim;
+      REQUIRE(p->load_norm() > 0);
+      core::VecH u = p->create_vector(), v = p->create_vector(), r = p->create_vector(),
+                 w = p->create_vector();
+      hstest::interpolate(
+          *p, [dim](const double* x, double* y) { smooth_field(x, y, dim, 1.0); }, u);
+      // A direction unrelated to u.
+      hstest::interpolate(
+          *p,
+          [dim](const double* x, double* y) {
+            y[0] = std::cos(2.0 * x[1]) + 0.3 * x[0];
+            y[1] = std::sin(1.7 * x[0]) - 0.2;
+            if (dim == 3) y[2] = x[0] * x[1] - 0.5 * std::cos(x[2]);
+          },
+          v);
+      for (double s : {0.0, 0.7}) {
+        REQUIRE(p->residual(u, s, r));
+        PetscScalar slope;
+        HS_PETSC(VecDot(r, v, &slope));
+        const double eps = 1e-4;
+        auto energy_at = [&](double t) {
+          HS_PETSC(VecWAXPY(w, t, v, u));
+          double e = 0;
+          REQUIRE(p->energy(w, s, e));
+          return e;
+        };
+        // 4th-order central difference of t -> Pi(u + t v) at t = 0.
+        const double fd =
+            (-energy_at(2 * eps) + 8 * energy_at(eps) - 8 * energy_at(-eps) + energy_at(-2 * eps)) /
+            (12 * eps);
+        INFO("load factor " << s << ": r.v = " << slope << ", FD = " << fd);
+        REQUIRE(std::abs(slope) > 1e-3);
+        CHECK(std::abs(fd - slope) <= 1e-7 * std::abs(slope));
+      }
+    }
+  }
+}
+
+TEST_CASE("Energy, residual and tangent report det F <= 0 instead of returning garbage",
+          "[assembly]") {
+  auto p = make_problem(2, 1);
+  core::VecH u = p->create_vector(), r = p->create_vector();
+  // Folds the disk over itself: u_x = -2.5 x gives F_11 = -1.5 everywhere.
+  hstest::interpolate(
+      *p,
+      [](const double* x, double* v) {
+        v[0] = -2.5 * x[0];
+        v[1] = 0.0;
+      },
+      u);
+  REQUIRE(p->min_det_f(u) < 0);
+  double e = 0;
+  CHECK_FALSE(p->energy(u, 0.0, e));
+  CHECK(std::isinf(e));
+  CHECK_FALSE(p->residual(u, 0.0, r));
+  core::MatH J = p->create_matrix();
+  CHECK_FALSE(p->jacobian(u, J));
+}

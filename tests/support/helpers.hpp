@@ -1,0 +1,134 @@
+#pragma once
+/// Shared helpers for the verification tests: nodal interpolation of analytic fields, local
+/// vectors with the (homogeneous) essential values, quadrature L2 errors, facet predicates and
+/// the seed paper's disk scene.
+#include <petscdmplex.h>
+
+#include <cmath>
+#include <functional>
+#include <random>
+#include <vector>
+
+#include "hypershape/core/error.hpp"
+#include "hypershape/core/petsc_handle.hpp"
+#include "hypershape/mesh/gmsh_mesher.hpp"
+#include "hypershape/physics/problem.hpp"
+#include "hypershape/physics/registry.hpp"
+
+namespace hstest {
+
+namespace hs = hypershape;
+using Field = std::function<void(const double* x, double* u)>;
+
+/// A local vector of the problem's DM holding the global vector `u`, with the homogeneous
+/// essential values (zero) in the constrained slots. Collective.
+inline hs::core::VecH local_copy(const hs::physics::Problem& p, Vec u) {
+  hs::core::VecH ul;
+  HS_PETSC(DMCreateLocalVector(p.dm(), ul.out()));
+  HS_PETSC(VecZeroEntries(ul));
+  HS_PETSC(DMGlobalToLocal(p.dm(), u, INSERT_VALUES, ul));
+  return ul;
+}
+
+/// Sets the global vector `u` to the nodal interpolant of `f` (constrained dofs are dropped by
+/// the global layout). Collective.
+inline void interpolate(const hs::physics::Problem& p, const Field& f, Vec u) {
+  const int dim = p.space().dim();
+  hs::core::VecH ul;
+  HS_PETSC(DMCreateLocalVector(p.dm(), ul.out()));
+  HS_PETSC(VecZeroEntries(ul));
+  PetscScalar* a;
+  HS_PETSC(VecGetArray(ul, &a));
+  for (const auto& n : p.space().owned_nodes()) {
+    double v[3] = {0, 0, 0};
+    f(n.x.data(), v);
+    for (int i = 0; i < dim; ++i) a[n.offset + i] = v[i];
+  }
+  HS_PETSC(VecRestoreArray(ul, &a));
+  HS_PETSC(VecZeroEntries(u));
+  HS_PETSC(DMLocalToGlobal(p.dm(), ul, INSERT_VALUES, u));
+}
+
+/// ( int_Omega |u_h - u*|^2 )^(1/2) with the space's cell rule (all quadrature points). Collective.
+inline double l2_error(const hs::physics::Problem& p, Vec u, const Field& exact) {
+  const auto& s = p.space();
+  const int dim = s.dim(), nb = s.n_nodes();
+  hs::core::VecH ul = local_copy(p, u);
+  const PetscScalar* a;
+  HS_PETSC(VecGetArrayRead(ul, &a));
+  double sum = 0;
+  for (PetscInt c = s.cell_begin(); c < s.cell_end(); ++c) {
+    const PetscInt* idx = s.local_dofs(c);
+    for (int q = 0; q < s.n_qp(); ++q) {
+      double x[3] = {0, 0, 0}, ue[3] = {0, 0, 0}, uh[3] = {0, 0, 0};
+      s.map_point(c, q, x);
+      exact(x, ue);
+      for (int b = 0; b < nb; ++b)
+        for (int i = 0; i < dim; ++i) uh[i] += s.basis(q, b) * PetscRealPart(a[idx[b * dim + i]]);
+      double e2 = 0;
+      for (int i = 0; i < dim; ++i) e2 += (uh[i] - ue[i]) * (uh[i] - ue[i]);
+      sum += s.qweight(q) * s.det_jacobian(c) * e2;
+    }
+  }
+  HS_PETSC(VecRestoreArrayRead(ul, &a));
+  MPI_Allreduce(MPI_IN_PLACE, &sum, 1, MPI_DOUBLE, MPI_SUM, p.comm());
+  return std::sqrt(sum);
+}
+
+/// Measure of the domain by the cell rule (a check of weights, det J and the partition).
+inline double domain_measure(const hs::physics::Problem& p) {
+  const auto& s = p.space();
+  double sum = 0;
+  for (PetscInt c = s.cell_begin(); c < s.cell_end(); ++c)
+    for (int q = 0; q < s.n_qp(); ++q) sum += s.qweight(q) * s.det_jacobian(c);
+  MPI_Allreduce(MPI_IN_PLACE, &sum, 1, MPI_DOUBLE, MPI_SUM, p.comm());
+  return sum;
+}
+
+/// Facets whose vertices all have coordinate `axis` equal to `value` (to 1e-12).
+inline hs::physics::FacetPredicate on_plane(int axis, double value) {
+  return [axis, value](const double* x, int nv, int dim) {
+    for (int a = 0; a < nv; ++a)
+      if (std::abs(x[a * dim + axis] - value) > 1e-12) return false;
+    return true;
+  };
+}
+
+inline hs::physics::FacetPredicate everywhere() {
+  return [](const double*, int, int) { return true; };
+}
+
+/// || a - b ||_2 / || b ||_2 of two global vectors (collective).
+inline double rel_diff(Vec a, Vec b) {
+  hs::core::VecH d;
+  HS_PETSC(VecDuplicate(a, d.out()));
+  HS_PETSC(VecWAXPY(d, -1.0, b, a));
+  PetscReal nd, nb;
+  HS_PETSC(VecNorm(d, NORM_2, &nd));
+  HS_PETSC(VecNorm(b, NORM_2, &nb));
+  return nd / nb;
+}
+
+/// The seed paper's 2D scene: unit disk clamped near (1, 0) (r = 0.5), Gaussian traction at
+/// (-1, 0) pointing in +y (gamma 0.2), Neo-Hookean E = 500, nu = 0.49.
+inline hs::mesh::MeshData disk_mesh(double h) {
+  hs::mesh::MeshOptions mo;
+  mo.h = h;
+  return hs::mesh::mesh_disk(mo, hs::mesh::ClampRegion{{1.0, 0.0, 0.0}, 0.5});
+}
+
+inline std::vector<hs::physics::EffectPtr> disk_effects(double E = 500, double nu = 0.49) {
+  std::vector<hs::physics::EffectPtr> e;
+  e.push_back(hs::physics::make_neo_hookean(E, nu));
+  e.push_back(hs::physics::make_dirichlet_patch({1.0, 0.0}, 0.5));
+  e.push_back(hs::physics::make_gaussian_traction({-1.0, 0.0}, {0.0, 1.0}, 0.2));
+  return e;
+}
+
+inline hs::physics::SpaceOptions degree(int p) {
+  hs::physics::SpaceOptions o;
+  o.degree = p;
+  return o;
+}
+
+}  // namespace hstest
