@@ -84,6 +84,7 @@ def main():
             f"{fmt_time(t.get('jacobian_pointwise'))} ({fmt_ratio(d.get('jacobian_pointwise_speedup'))})",
             fmt_time(t.get("factor_first")), fmt_time(t.get("factor_repeat")),
             fmt_time(t.get("triangular_solve")),
+            fmt_time(t["global_to_local"] + t["insert_bc"]) if "insert_bc" in t else "-",
         ])
         for n in c.get("notes", []):
             remarks.append(f"- {c['dim']}D P{c['degree']} h={c['h']}: {n}")
@@ -94,7 +95,7 @@ def main():
     print()
     print(table(["dim", "P", "h", "residual", "Jacobian", "residual, PETSc pointwise (ratio)",
                  "Jacobian, PETSc pointwise (ratio)", "1st factorisation", "numeric factorisation",
-                 "triangular solve"], rows2))
+                 "triangular solve", "to_local"], rows2))
     if remarks:
         print()
         print("\n".join(remarks))
