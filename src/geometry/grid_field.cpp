@@ -1,0 +1,190 @@
+#include "hypershape/geometry/grid_field.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+
+namespace hypershape::geometry {
+
+Grid Grid::covering(int dim, std::span<const double> lo, std::span<const double> hi,
+                    double spacing) {
+  assert(dim == 2 || dim == 3);
+  Grid g;
+  g.dim = dim;
+  g.spacing = spacing;
+  for (int a = 0; a < dim; ++a) {
+    const int cells = std::max(1, int(std::ceil((hi[a] - lo[a]) / spacing)));
+    // Centre the node lattice on the box so that the cover is symmetric.
+    const double extra = cells * spacing - (hi[a] - lo[a]);
+    g.lower[a] = lo[a] - 0.5 * extra;
+    g.n[a] = cells + 1;
+  }
+  return g;
+}
+
+GridField::GridField(const Grid& grid)
+    : grid_(grid), values_(std::size_t(grid.dim * grid.n_nodes()), 0.0) {}
+
+void GridField::node_coords(std::int64_t node, double* x) const {
+  const std::int64_t i = node % grid_.n[0];
+  const std::int64_t j = (node / grid_.n[0]) % grid_.n[1];
+  const std::int64_t k = node / (std::int64_t(grid_.n[0]) * grid_.n[1]);
+  const std::int64_t ijk[3] = {i, j, k};
+  for (int a = 0; a < grid_.dim; ++a) x[a] = grid_.lower[a] + double(ijk[a]) * grid_.spacing;
+}
+
+namespace {
+
+/// Catmull-Rom weights of nodes i-1..i+2 for the local coordinate t in [0, 1).
+inline void catmull_rom(double t, double w[4]) {
+  const double t2 = t * t, t3 = t2 * t;
+  w[0] = 0.5 * (-t3 + 2.0 * t2 - t);
+  w[1] = 0.5 * (3.0 * t3 - 5.0 * t2 + 2.0);
+  w[2] = 0.5 * (-3.0 * t3 + 4.0 * t2 + t);
+  w[3] = 0.5 * (t3 - t2);
+}
+
+/// Stencil along one axis: clamped node indices and weights.
+inline void stencil(double x, double lower, double spacing, int n, int idx[4], double w[4]) {
+  if (n == 1) {
+    idx[0] = idx[1] = idx[2] = idx[3] = 0;
+    w[0] = w[2] = w[3] = 0.0;
+    w[1] = 1.0;
+    return;
+  }
+  double s = (x - lower) / spacing;
+  s = std::clamp(s, 0.0, double(n - 1));
+  int i = std::min(int(s), n - 2);
+  catmull_rom(s - i, w);
+  for (int q = 0; q < 4; ++q) idx[q] = std::clamp(i - 1 + q, 0, n - 1);
+}
+
+template <int D>
+void evaluate_impl(const Grid& g, const double* values, const double* x, double* out) {
+  int ix[3][4];
+  double wx[3][4];
+  for (int a = 0; a < 3; ++a) stencil(a < D ? x[a] : 0.0, g.lower[a], g.spacing, g.n[a], ix[a], wx[a]);
+  const std::int64_t n_nodes = g.n_nodes();
+  const std::int64_t s1 = g.n[0], s2 = std::int64_t(g.n[0]) * g.n[1];
+  double acc[D] = {};
+  const int kz = D == 3 ? 4 : 1;
+  for (int c = 0; c < kz; ++c) {
+    const double wz = D == 3 ? wx[2][c] : 1.0;
+    const std::int64_t oz = D == 3 ? ix[2][c] * s2 : 0;
+    for (int b = 0; b < 4; ++b) {
+      const double wyz = wz * wx[1][b];
+      const std::int64_t oyz = oz + ix[1][b] * s1;
+      for (int a = 0; a < 4; ++a) {
+        const double w = wyz * wx[0][a];
+        const std::int64_t node = oyz + ix[0][a];
+        for (int d = 0; d < D; ++d) acc[d] += w * values[d * n_nodes + node];
+      }
+    }
+  }
+  for (int d = 0; d < D; ++d) out[d] = acc[d];
+}
+
+/// Symmetric square root factor A (A A^T = C) of the 1D kernel matrix
+/// C_ij = exp(-(x_i - x_j)^2 / (2 sigma^2)). Eigenvalues that round-off makes slightly negative
+/// are set to zero (the matrix is positive semi-definite in exact arithmetic).
+Eigen::MatrixXd kernel_factor(int n, double spacing, double sigma) {
+  Eigen::MatrixXd c(n, n);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const double d = (i - j) * spacing;
+      c(i, j) = std::exp(-d * d / (2.0 * sigma * sigma));
+    }
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(c);
+  const Eigen::VectorXd root = eig.eigenvalues().cwiseMax(0.0).cwiseSqrt();
+  return eig.eigenvectors() * root.asDiagonal();
+}
+
+}  // namespace
+
+void GridField::evaluate(const double* x, double* value) const {
+  if (grid_.dim == 2)
+    evaluate_impl<2>(grid_, values_.data(), x, value);
+  else
+    evaluate_impl<3>(grid_, values_.data(), x, value);
+}
+
+double GridField::max_norm() const {
+  const std::int64_t n = grid_.n_nodes();
+  double m2 = 0.0;
+  for (std::int64_t i = 0; i < n; ++i) {
+    double s = 0.0;
+    for (int d = 0; d < grid_.dim; ++d) s += values_[d * n + i] * values_[d * n + i];
+    m2 = std::max(m2, s);
+  }
+  return std::sqrt(m2);
+}
+
+GridField sample_velocity_field(const Grid& grid, double sigma, double m,
+                                core::RandomStream& rng) {
+  assert(sigma > 0.0);
+  GridField field(grid);
+  const int n0 = grid.n[0], n1 = grid.n[1], n2 = grid.n[2];
+  const Eigen::MatrixXd a0 = kernel_factor(n0, grid.spacing, sigma);
+  const Eigen::MatrixXd a1 = kernel_factor(n1, grid.spacing, sigma);
+  const Eigen::MatrixXd a2 = grid.dim == 3 ? kernel_factor(n2, grid.spacing, sigma)
+                                           : Eigen::MatrixXd::Identity(1, 1);
+  using Map = Eigen::Map<Eigen::MatrixXd>;
+  for (int c = 0; c < grid.dim; ++c) {
+    std::span<double> v = field.component(c);
+    for (double& xi : v) xi = rng.normal();
+    // Axis 0: the node array as an n0 x (n1 n2) column-major matrix.
+    Map m0(v.data(), n0, std::int64_t(n1) * n2);
+    m0 = (a0 * m0).eval();
+    // Axis 1: each z-slab is an n0 x n1 matrix.
+    for (int k = 0; k < n2; ++k) {
+      Map slab(v.data() + std::int64_t(k) * n0 * n1, n0, n1);
+      slab = (slab * a1.transpose()).eval();
+    }
+    // Axis 2: the array as an (n0 n1) x n2 matrix.
+    if (grid.dim == 3) {
+      Map m2(v.data(), std::int64_t(n0) * n1, n2);
+      m2 = (m2 * a2.transpose()).eval();
+    }
+    for (double& x : v) x *= m;
+  }
+  return field;
+}
+
+GridField exponentiate(GridField v, int n_squarings) {
+  assert(n_squarings >= 0);
+  const Grid g = v.grid();
+  const int dim = g.dim;
+  const std::int64_t n = g.n_nodes();
+  const double tau = std::ldexp(1.0, -n_squarings);
+  GridField u(g);
+  double x[3], y[3], w[3];
+  // Midpoint step: u_0(x) = tau v(x + tau v(x) / 2).
+  for (std::int64_t i = 0; i < n; ++i) {
+    u.node_coords(i, x);
+    for (int d = 0; d < dim; ++d) y[d] = x[d] + 0.5 * tau * v.component(d)[i];
+    v.evaluate(y, w);
+    for (int d = 0; d < dim; ++d) u.component(d)[i] = tau * w[d];
+  }
+  // Squarings: phi <- phi o phi, i.e. u(x) <- u(x) + u(x + u(x)); v's storage is reused.
+  GridField next = std::move(v);
+  for (int s = 0; s < n_squarings; ++s) {
+    for (std::int64_t i = 0; i < n; ++i) {
+      u.node_coords(i, x);
+      for (int d = 0; d < dim; ++d) y[d] = x[d] + u.component(d)[i];
+      u.evaluate(y, w);
+      for (int d = 0; d < dim; ++d) next.component(d)[i] = u.component(d)[i] + w[d];
+    }
+    std::swap(u, next);
+  }
+  return u;
+}
+
+int default_squarings(const GridField& v) {
+  const double vmax = v.max_norm();
+  int n = 0;
+  while (std::ldexp(vmax, -n) > v.grid().spacing / 8.0 && n < 30) ++n;
+  return n;
+}
+
+}  // namespace hypershape::geometry
