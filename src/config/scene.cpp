@@ -9,93 +9,13 @@
 #include <sstream>
 
 #include "hypershape/core/error.hpp"
+#include "yaml_block.hpp"
 
 namespace hypershape::config {
 
 namespace {
 
 using core::InputError;
-
-std::string join(const std::string& a, const std::string& b) {
-  return a.empty() ? b : b.empty() ? a : a + "." + b;
-}
-
-/// Key checks for one YAML mapping.
-class Block {
- public:
-  Block(const YAML::Node& node, std::string file, std::string path)
-      : node_(node), file_(std::move(file)), path_(std::move(path)) {
-    if (node_ && !node_.IsNull() && !node_.IsMap())
-      throw InputError(file_, path_, "must be a mapping of keys to values");
-  }
-  [[noreturn]] void fail(const std::string& key, const std::string& msg) const {
-    throw InputError(file_, join(path_, key), msg);
-  }
-  bool has(const std::string& key) const {
-    used_.insert(key);
-    return node_ && node_.IsMap() && node_[key] && !node_[key].IsNull();
-  }
-  YAML::Node get(const std::string& key) const {
-    used_.insert(key);
-    return node_ && node_.IsMap() ? node_[key] : YAML::Node();
-  }
-  double number(const std::string& key) const {
-    auto n = get(key);
-    if (!n || n.IsNull()) fail(key, "missing (a number is required)");
-    if (!n.IsScalar()) fail(key, "must be a number");
-    double v;
-    try {
-      v = n.as<double>();
-    } catch (const YAML::Exception&) {
-      fail(key, "must be a number, got '" + n.Scalar() + "'");
-    }
-    if (!std::isfinite(v)) fail(key, "must be a finite number");
-    return v;
-  }
-  long integer(const std::string& key) const {
-    const double v = number(key);
-    if (v != std::floor(v)) fail(key, "must be an integer");
-    return long(v);
-  }
-  std::string text(const std::string& key) const {
-    auto n = get(key);
-    if (!n || n.IsNull()) fail(key, "missing (a string is required)");
-    if (!n.IsScalar()) fail(key, "must be a string");
-    return n.Scalar();
-  }
-  std::vector<double> vector(const std::string& key, std::size_t n) const {
-    auto v = get(key);
-    if (!v || v.IsNull()) fail(key, "missing (a list of " + std::to_string(n) + " numbers is required)");
-    if (!v.IsSequence() || v.size() != n)
-      fail(key, "must be a list of " + std::to_string(n) + " numbers");
-    std::vector<double> out;
-    for (const auto& e : v) {
-      double x;
-      try {
-        x = e.as<double>();
-      } catch (const YAML::Exception&) {
-        fail(key, "must be a list of " + std::to_string(n) + " numbers");
-      }
-      if (!std::isfinite(x)) fail(key, "must hold finite numbers");
-      out.push_back(x);
-    }
-    return out;
-  }
-  void check_all_used() const {
-    if (!node_ || !node_.IsMap()) return;
-    for (const auto& kv : node_) {
-      const auto k = kv.first.Scalar();
-      if (!used_.count(k)) fail(k, "unknown key" + (allowed_.empty() ? "" : "; allowed: " + allowed_));
-    }
-  }
-  void allowed(std::string a) { allowed_ = std::move(a); }
-  const YAML::Node& node() const { return node_; }
-
- private:
-  YAML::Node node_;
-  std::string file_, path_, allowed_;
-  mutable std::set<std::string> used_;
-};
 
 class YamlEffectParams : public EffectParams {
  public:
@@ -113,7 +33,7 @@ class YamlEffectParams : public EffectParams {
   void check_all_used() const override { block_.check_all_used(); }
 
  private:
-  Block block_;
+  YamlBlock block_;
 };
 
 }  // namespace
@@ -141,7 +61,7 @@ Scene parse_scene_text(const std::string& text, const std::string& source, const
   Scene s;
   s.source = source;
   s.text = text;
-  Block top(root, source, "");
+  YamlBlock top(root, source, "");
   top.allowed("geometry, mesh, effects, load, solver, petsc");
   for (const auto& kv : root) {
     static const std::set<std::string> sections = {"geometry", "mesh", "effects", "load", "solver", "petsc"};
@@ -149,7 +69,7 @@ Scene parse_scene_text(const std::string& text, const std::string& source, const
       top.fail(kv.first.Scalar(), "unknown key; allowed: geometry, mesh, effects, load, solver, petsc");
   }
 
-  Block geo(top.get("geometry"), source, "geometry");
+  YamlBlock geo(top.get("geometry"), source, "geometry");
   if (!top.has("geometry")) top.fail("geometry", "missing (e.g. geometry: {base: circle})");
   s.base = geo.text("base");
   if (s.base == "circle") {
@@ -170,7 +90,7 @@ Scene parse_scene_text(const std::string& text, const std::string& source, const
   geo.allowed("base, file");
   geo.check_all_used();
 
-  Block mesh(top.get("mesh"), source, "mesh");
+  YamlBlock mesh(top.get("mesh"), source, "mesh");
   if (mesh.has("h")) {
     s.h = mesh.number("h");
     if (!(s.h > 0 && s.h <= 1)) mesh.fail("h", "must be in (0, 1]");
@@ -188,7 +108,7 @@ Scene parse_scene_text(const std::string& text, const std::string& source, const
   mesh.check_all_used();
 
   if (!top.has("effects")) top.fail("effects", "missing (a mapping of effect names to parameters)");
-  Block eff(top.get("effects"), source, "effects");
+  YamlBlock eff(top.get("effects"), source, "effects");
   for (const auto& kv : eff.node()) {
     const std::string name = kv.first.Scalar();
     eff.get(name);  // mark used; the registry checks the name when the effect is built
@@ -196,7 +116,7 @@ Scene parse_scene_text(const std::string& text, const std::string& source, const
   }
   if (s.effects.empty()) top.fail("effects", "must list at least one effect");
 
-  Block load(top.get("load"), source, "load");
+  YamlBlock load(top.get("load"), source, "load");
   if (!top.has("load")) top.fail("load", "missing (load: {target: 0.3} or load: {alpha: 10})");
   if (load.has("alpha") == load.has("target")) load.fail("", "give exactly one of alpha, target");
   if (load.has("alpha")) {
@@ -209,7 +129,7 @@ Scene parse_scene_text(const std::string& text, const std::string& source, const
   load.allowed("alpha, target");
   load.check_all_used();
 
-  Block sol(top.get("solver"), source, "solver");
+  YamlBlock sol(top.get("solver"), source, "solver");
   if (sol.has("rtol")) s.solver.rtol = sol.number("rtol");
   if (!(s.solver.rtol > 0 && s.solver.rtol < 1)) sol.fail("rtol", "must be in (0, 1)");
   if (sol.has("max_newton")) s.solver.max_newton = int(sol.integer("max_newton"));
@@ -221,7 +141,7 @@ Scene parse_scene_text(const std::string& text, const std::string& source, const
   sol.allowed("rtol, max_newton, max_increments, target_rtol");
   sol.check_all_used();
 
-  Block petsc(top.get("petsc"), source, "petsc");
+  YamlBlock petsc(top.get("petsc"), source, "petsc");
   if (petsc.node() && petsc.node().IsMap())
     for (const auto& kv : petsc.node()) {
       const std::string k = kv.first.Scalar();

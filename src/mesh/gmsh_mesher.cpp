@@ -9,32 +9,18 @@
 #include <numbers>
 #include <unordered_map>
 
+#include "gmsh_util.hpp"
 #include "hypershape/core/error.hpp"
 
 namespace hypershape::mesh {
 
 namespace {
 
+using detail::last_gmsh_error;
+using detail::restart_gmsh;
+using detail::ScopedModel;
+
 int g_sessions = 0;
-
-/// Opens a gmsh session for the duration of one meshing call unless one is already open.
-class ScopedModel {
- public:
-  explicit ScopedModel(const std::string& name) {
-    if (!GmshSession::active()) own_.emplace();
-    gmsh::model::add(name);
-    gmsh::model::setCurrent(name);
-  }
-  ~ScopedModel() {
-    try {
-      gmsh::model::remove();
-    } catch (...) {
-    }
-  }
-
- private:
-  std::optional<GmshSession> own_;
-};
 
 /// Deterministic, quiet, serial meshing with the size given only by the background field.
 void set_common_options(double h) {
@@ -138,26 +124,6 @@ MeshData extract(int dim) {
     if (flip) std::swap(cell[1], cell[2]);
   }
   return m;
-}
-
-/// After gmsh throws inside open() it stays locked ("I'm busy!") and keeps its last error:
-/// restart it so later meshing works.
-void restart_gmsh() {
-  try {
-    gmsh::finalize();
-  } catch (...) {
-  }
-  gmsh::initialize(0, nullptr, false);
-  gmsh::option::setNumber("General.Terminal", 0);
-}
-
-std::string last_gmsh_error() {
-  std::string err;
-  try {
-    gmsh::logger::getLastError(err);
-  } catch (...) {
-  }
-  return err;
 }
 
 /// gmsh 4.8 throws std::string (and sometimes nothing): turn both into exceptions we own.

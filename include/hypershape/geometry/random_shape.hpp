@@ -30,8 +30,8 @@ struct DeformationSpec {
   int dim = 2;
   std::vector<DeformationStep> steps;  ///< applied in order (coarse first, as in the paper)
   /// Units of m: the velocity standard deviation is m * velocity_unit (base radius 1). The paper
-  /// does not state the unit; 0.05 reproduces its descriptions (see README, "Random shapes").
-  double velocity_unit = 0.05;
+  /// does not state the unit; 0.04 matches its descriptions (see README, "Random shapes").
+  double velocity_unit = 0.04;
   /// Grid spacing = sigma / nodes_per_sigma; 0 picks 6 in 2D and 3 in 3D (memory: the finest
   /// 3D step of Random3D then needs two grids of about 4.7M nodes; see README for accuracy).
   double nodes_per_sigma = 0.0;

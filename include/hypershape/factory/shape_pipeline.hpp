@@ -1,0 +1,73 @@
+#pragma once
+/// One random shape, from ids to a checked mesh: draw the deformation, resolve the boundary,
+/// draw the Dirichlet patch on it, make the boundary conform to the patch ends, mesh, gate the
+/// quality, measure. A draw that fails any check is redrawn from the next sub-seed (attempt)
+/// and the failure is recorded, never dropped silently. Not collective: every rank computes
+/// the same shape for the same (seed, shape id).
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "hypershape/geometry/boundary.hpp"
+#include "hypershape/geometry/metrics.hpp"
+#include "hypershape/geometry/random_shape.hpp"
+#include "hypershape/mesh/mesh_data.hpp"
+#include "hypershape/mesh/quality.hpp"
+
+namespace hypershape::factory {
+
+/// A family of random shapes (the `shapes:` block of a dataset config).
+struct ShapeConfig {
+  std::string name;                      ///< preset name, for reports
+  int dim = 2;
+  std::string base = "circle";           ///< circle | sphere | file
+  std::string base_file;                 ///< surface file (STL / .msh) when base == file
+  geometry::DeformationSpec deformation;  ///< steps, velocity unit, grid resolution
+  double h = 0.05;                       ///< target element size (normalised units)
+  double dirichlet_radius = 0.5;         ///< r of the Dirichlet patch; 0: no patch
+  double max_turn_deg = 15.0;            ///< 2D: largest turning angle per boundary edge
+  double min_feature_fraction = 0.1;     ///< redraw if a feature is thinner than this * h
+  double size_grading = 0.3;             ///< growth of the boundary size per unit length
+  int max_attempts = 20;                 ///< give up (error) after this many redraws
+  mesh::QualityGate quality;             ///< defaults per dimension, see quality.hpp
+};
+
+/// A rejected draw: which attempt, at which stage, and why.
+struct RejectedDraw {
+  int attempt = 0;
+  std::string stage;   ///< boundary | feature | mesh | quality
+  std::string reason;
+};
+
+/// Everything a dataset keeps about one shape.
+struct ShapeSample {
+  std::int64_t shape_id = 0;
+  int attempt = 0;                          ///< the accepted sub-seed
+  geometry::Boundary boundary;              ///< boundary point i is mesh vertex i
+  mesh::MeshData mesh;
+  std::array<double, 3> dirichlet_center{};  ///< p_D (on the boundary)
+  double dirichlet_radius = 0.0;
+  std::vector<int> dirichlet_facets;        ///< boundary facets inside the patch
+  geometry::ShapeMetrics metrics;
+  mesh::MeshQuality quality;
+  std::vector<RejectedDraw> rejected;
+  double seconds_draw = 0, seconds_mesh = 0, seconds_metrics = 0;
+};
+
+/// Loads the base surface of `config` (base == file) normalised into [-1, 1]^3; nullopt for
+/// circle/sphere. Throws core::InputError for a bad file.
+std::optional<geometry::Boundary> load_base(const ShapeConfig& config);
+
+/// The base boundary the metrics compare against: the unit circle / sphere, or the loaded
+/// surface.
+geometry::Boundary reference_base(const ShapeConfig& config,
+                                  const std::optional<geometry::Boundary>& loaded);
+
+/// Draws shape `shape_id` of the family. `base` is load_base(config). Throws
+/// std::runtime_error if max_attempts draws all fail (with every reason in the message).
+ShapeSample make_shape(const ShapeConfig& config, const std::optional<geometry::Boundary>& base,
+                       std::uint64_t seed, std::int64_t shape_id);
+
+}  // namespace hypershape::factory

@@ -1,0 +1,245 @@
+#include "hypershape/factory/shape_pipeline.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <stdexcept>
+
+#include "hypershape/core/random.hpp"
+#include "hypershape/core/timer.hpp"
+#include "hypershape/geometry/boundary_check.hpp"
+#include "hypershape/geometry/surface_remesh.hpp"
+#include "hypershape/mesh/boundary_mesher.hpp"
+#include "hypershape/mesh/surface_file.hpp"
+
+namespace hypershape::factory {
+
+namespace {
+
+/// A draw failed one of the checks: redraw with the next attempt.
+struct Rejection {
+  std::string stage, reason;
+};
+
+/// Scales a boundary into [-1, 1]^d (centred bounding box, largest half-extent 1).
+void normalise_into_box(geometry::Boundary& b) {
+  const int d = b.dim;
+  double lo[3], hi[3];
+  for (int a = 0; a < d; ++a) lo[a] = std::numeric_limits<double>::infinity(), hi[a] = -lo[a];
+  for (std::size_t i = 0; i < b.points.size(); i += d)
+    for (int a = 0; a < d; ++a) lo[a] = std::min(lo[a], b.points[i + a]), hi[a] = std::max(hi[a], b.points[i + a]);
+  double half = 0.0;
+  for (int a = 0; a < d; ++a) half = std::max(half, 0.5 * (hi[a] - lo[a]));
+  for (std::size_t i = 0; i < b.points.size(); i += d)
+    for (int a = 0; a < d; ++a) b.points[i + a] = (b.points[i + a] - 0.5 * (lo[a] + hi[a])) / half;
+}
+
+/// A point drawn uniformly (by length / area) on the facets of `b`.
+std::array<double, 3> uniform_boundary_point(const geometry::Boundary& b, core::RandomStream& rng) {
+  const int d = b.dim;
+  const std::int64_t n = b.n_facets();
+  std::vector<double> cumulative(std::size_t(n) + 1, 0.0);
+  for (std::int64_t f = 0; f < n; ++f) {
+    const auto v = b.facet(f);
+    const auto p = b.point(v[0]), q = b.point(v[1]);
+    double measure;
+    if (d == 2) {
+      measure = std::hypot(q[0] - p[0], q[1] - p[1]);
+    } else {
+      const auto r = b.point(v[2]);
+      const double u[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+      const double w[3] = {r[0] - p[0], r[1] - p[1], r[2] - p[2]};
+      measure = 0.5 * std::sqrt(std::pow(u[1] * w[2] - u[2] * w[1], 2) +
+                                std::pow(u[2] * w[0] - u[0] * w[2], 2) +
+                                std::pow(u[0] * w[1] - u[1] * w[0], 2));
+    }
+    cumulative[std::size_t(f) + 1] = cumulative[std::size_t(f)] + measure;
+  }
+  const double target = rng.uniform() * cumulative.back();
+  const auto it = std::upper_bound(cumulative.begin(), cumulative.end(), target);
+  const std::int64_t f = std::clamp<std::int64_t>(it - cumulative.begin() - 1, 0, n - 1);
+  const auto v = b.facet(f);
+  std::array<double, 3> x{};
+  if (d == 2) {
+    const double t = rng.uniform();
+    for (int a = 0; a < 2; ++a) x[a] = (1 - t) * b.point(v[0])[a] + t * b.point(v[1])[a];
+  } else {
+    double s = rng.uniform(), t = rng.uniform();
+    if (s + t > 1.0) s = 1.0 - s, t = 1.0 - t;
+    for (int a = 0; a < 3; ++a)
+      x[a] = (1 - s - t) * b.point(v[0])[a] + s * b.point(v[1])[a] + t * b.point(v[2])[a];
+  }
+  return x;
+}
+
+/// Per boundary point: the mean length of its facets' edges through it (the resolved size).
+std::vector<double> boundary_spacing(const geometry::Boundary& b) {
+  std::vector<double> sum(std::size_t(b.n_points()), 0.0), count(sum.size(), 0.0);
+  const int d = b.dim;
+  for (std::int64_t f = 0; f < b.n_facets(); ++f) {
+    const auto v = b.facet(f);
+    for (int e = 0; e < d; ++e) {
+      const int i = v[e], j = v[(e + 1) % d];
+      if (d == 2 && e == 1) break;  // a segment has one edge
+      double l2 = 0.0;
+      for (int a = 0; a < d; ++a) l2 += std::pow(b.point(i)[a] - b.point(j)[a], 2);
+      const double l = std::sqrt(l2);
+      sum[i] += l, sum[j] += l, count[i] += 1, count[j] += 1;
+    }
+  }
+  for (std::size_t i = 0; i < sum.size(); ++i) sum[i] = count[i] > 0 ? sum[i] / count[i] : 0.0;
+  return sum;
+}
+
+std::vector<double> base_sample(const ShapeConfig& c, const std::optional<geometry::Boundary>& base) {
+  if (c.dim == 2) return geometry::unit_circle(2048).points;
+  if (base) return base->points;
+  return geometry::icosphere(4).points;
+}
+
+/// The boundary of one attempt, conforming to the Dirichlet patch; throws Rejection.
+geometry::Boundary draw_boundary(const ShapeConfig& c, const std::optional<geometry::Boundary>& base,
+                                 std::uint64_t seed, std::int64_t shape_id, int attempt,
+                                 ShapeSample& out) {
+  core::RandomStream rng(seed, core::Purpose::shape, {std::uint64_t(shape_id), std::uint64_t(attempt)});
+  core::RandomStream patch_rng(seed, core::Purpose::dirichlet, {std::uint64_t(shape_id), std::uint64_t(attempt)});
+  geometry::DeformationSpec spec = c.deformation;
+  spec.dim = c.dim;
+  geometry::RandomDeformation phi = geometry::sample_deformation(spec, base_sample(c, base), rng);
+  const double h = c.h;
+  const double min_feature = c.min_feature_fraction * h;
+  if (c.dim == 2) {
+    const double max_turn = c.max_turn_deg * std::numbers::pi / 180.0;
+    // Dense exact samples: a quarter of h and a fifth of the turning allowance per chord.
+    const geometry::CurveSamples dense = geometry::sample_circle_image(phi, h / 4, max_turn / 5);
+    const geometry::Boundary dense_polygon = geometry::polygon_boundary(dense.xy);
+    if (const auto check = geometry::check_boundary(dense_polygon); !check.ok)
+      throw Rejection{"boundary", check.reason};
+    // Local size: h, limited by curvature (turning <= max_turn per edge) and by the interior
+    // medial radius (at least two elements across every neck).
+    const std::vector<double> radius_in = geometry::inscribed_radii(dense_polygon);
+    const std::vector<double> radius_curv = geometry::curvature_radii(dense, h / 16);
+    std::vector<double> size(dense.size());
+    // A neck is where the inscribed ball is held by the opposite side (its radius is well below
+    // the local radius of curvature); a tight bend (tip) is resolved down to min_feature but
+    // not rejected: the mesh quality gate decides whether it can be meshed.
+    double thinnest = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < size.size(); ++i) {
+      if (radius_in[i] < 0.5 * radius_curv[i]) thinnest = std::min(thinnest, radius_in[i]);
+      size[i] = std::max(min_feature, std::min({h, radius_curv[i] * max_turn, radius_in[i]}));
+    }
+    if (thinnest < min_feature)
+      throw Rejection{"feature", fmt::format("a neck of half-width {:.3g} is thinner than {:.3g} "
+                                             "(min_feature_fraction * h)", thinnest, min_feature)};
+    geometry::grade_sizes(dense, size, c.size_grading);
+    std::vector<double> forced;
+    if (c.dirichlet_radius > 0) {
+      out.dirichlet_center = uniform_boundary_point(dense_polygon, patch_rng);
+      // p_D sits on a chord of the dense samples; the exact crossings are on the curve.
+      forced = geometry::circle_crossings(phi, dense, {out.dirichlet_center.data(), 2}, c.dirichlet_radius);
+    }
+    geometry::Boundary b = geometry::resolve_curve(phi, dense, size, forced);
+    if (const auto check = geometry::check_boundary(b); !check.ok) throw Rejection{"boundary", check.reason};
+    return b;
+  }
+  // 3D: resolve the surface at h in the pre-image, then remesh it to h (conforming to the
+  // patch curve).
+  const geometry::BaseKind kind = base ? geometry::BaseKind::triangulated : geometry::BaseKind::sphere;
+  const geometry::Boundary base_surface = base ? *base : geometry::icosphere(3);
+  geometry::SurfaceSamples dense;
+  try {
+    dense = geometry::sample_surface_image(phi, base_surface, kind, h, 2'000'000);
+  } catch (const std::runtime_error& e) {
+    throw Rejection{"boundary", e.what()};
+  }
+  geometry::RemeshOptions remesh;
+  remesh.target_edge = h;
+  if (c.dirichlet_radius > 0) {
+    out.dirichlet_center = uniform_boundary_point(dense.surface, patch_rng);
+    remesh.clamp_center = out.dirichlet_center;
+    remesh.clamp_radius = c.dirichlet_radius;
+  }
+  geometry::Boundary b;
+  try {
+    b = geometry::remesh_surface(dense.surface, remesh);
+  } catch (const std::exception& e) {
+    throw Rejection{"boundary", e.what()};
+  }
+  if (const auto check = geometry::check_boundary(b); !check.ok) throw Rejection{"boundary", check.reason};
+  const std::vector<double> radius_in = geometry::inscribed_radii(b);
+  const double thinnest = *std::min_element(radius_in.begin(), radius_in.end());
+  // Surfaces are remeshed uniformly at h (CGAL 5.5 has no adaptive sizing), so a neck must
+  // hold at least two boundary edges across.
+  if (thinnest < std::max(min_feature, 0.25 * h))
+    throw Rejection{"feature", fmt::format("a neck of half-width {:.3g} is thinner than {:.3g} "
+                                           "(h / 4: surfaces are resolved uniformly at h)",
+                                           thinnest, std::max(min_feature, 0.25 * h))};
+  return b;
+}
+
+}  // namespace
+
+std::optional<geometry::Boundary> load_base(const ShapeConfig& config) {
+  if (config.base != "file") return std::nullopt;
+  geometry::Boundary b = mesh::read_surface_file(config.base_file);
+  normalise_into_box(b);
+  return b;
+}
+
+geometry::Boundary reference_base(const ShapeConfig& config,
+                                  const std::optional<geometry::Boundary>& loaded) {
+  if (loaded) return *loaded;
+  return config.dim == 2 ? geometry::unit_circle(4096) : geometry::icosphere(4);
+}
+
+ShapeSample make_shape(const ShapeConfig& config, const std::optional<geometry::Boundary>& base,
+                       std::uint64_t seed, std::int64_t shape_id) {
+  ShapeSample out;
+  out.shape_id = shape_id;
+  const mesh::QualityGate gate = config.quality.min_angle_deg > 0 || config.quality.min_shape > 0
+                                     ? config.quality
+                                     : mesh::QualityGate::defaults(config.dim);
+  for (int attempt = 0; attempt < config.max_attempts; ++attempt) {
+    const double t0 = core::now_seconds();
+    try {
+      out.boundary = draw_boundary(config, base, seed, shape_id, attempt, out);
+      const double t1 = core::now_seconds();
+      mesh::BoundaryMeshOptions mopt;
+      mopt.h = config.h;
+      mopt.point_sizes = boundary_spacing(out.boundary);
+      try {
+        out.mesh = mesh::mesh_boundary(out.boundary, mopt);
+      } catch (const std::runtime_error& e) {
+        throw Rejection{"mesh", e.what()};
+      }
+      out.quality = mesh::mesh_quality(out.mesh);
+      if (std::string why; !mesh::passes(out.quality, gate, &why)) throw Rejection{"quality", why};
+      const double t2 = core::now_seconds();
+      out.attempt = attempt;
+      out.dirichlet_radius = config.dirichlet_radius;
+      if (config.dirichlet_radius > 0) {
+        std::array<double, 3> c = out.dirichlet_center;
+        if (config.dim == 2) c[2] = 0.0;
+        out.dirichlet_facets = geometry::facets_in_ball(out.boundary, c, config.dirichlet_radius);
+      }
+      const geometry::Boundary ref = reference_base(config, base);
+      // Hausdorff accuracy (3D only): h / 8, i.e. 1.25% of the box half-width at h = 0.1.
+      out.metrics = geometry::compute_metrics(out.boundary, &ref, config.h / (config.dim == 2 ? 20 : 8));
+      out.seconds_draw = t1 - t0;
+      out.seconds_mesh = t2 - t1;
+      out.seconds_metrics = core::now_seconds() - t2;
+      return out;
+    } catch (const Rejection& r) {
+      out.rejected.push_back({attempt, r.stage, r.reason});
+    }
+  }
+  std::string why;
+  for (const auto& r : out.rejected) why += fmt::format("\n  attempt {} ({}): {}", r.attempt, r.stage, r.reason);
+  throw std::runtime_error(fmt::format("shape {} of '{}': no acceptable draw in {} attempts:{}",
+                                       shape_id, config.name, config.max_attempts, why));
+}
+
+}  // namespace hypershape::factory

@@ -1,0 +1,376 @@
+#include "hypershape/geometry/metrics.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cassert>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include "aabb.hpp"
+
+namespace hypershape::geometry {
+namespace {
+
+using Vec = std::array<double, 3>;
+
+Vec sub(const Vec& a, const Vec& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+double dot(const Vec& a, const Vec& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+double norm2(const Vec& a) { return dot(a, a); }
+Vec cross(const Vec& a, const Vec& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+Vec midpoint(const Vec& a, const Vec& b) {
+  return {0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), 0.5 * (a[2] + b[2])};
+}
+
+void check_dim(const Boundary& b, const char* what) {
+  if (b.dim != 2 && b.dim != 3)
+    throw std::invalid_argument(std::string(what) + ": boundary dimension must be 2 or 3, got " +
+                                std::to_string(b.dim));
+}
+
+/// Point i as a 3-vector (z = 0 in 2D).
+Vec point3(const Boundary& b, std::int64_t i) {
+  const auto p = b.point(i);
+  return {p[0], p[1], b.dim == 3 ? p[2] : 0.0};
+}
+
+/// Outward normal of facet f scaled by its measure (length in 2D, area in 3D).
+Vec facet_normal(const Boundary& b, std::int64_t f) {
+  const auto v = b.facet(f);
+  const Vec a = point3(b, v[0]), c = point3(b, v[1]);
+  if (b.dim == 2) return {c[1] - a[1], a[0] - c[0], 0.0};  // (c - a) rotated clockwise
+  const Vec d = point3(b, v[2]);
+  const Vec n = cross(sub(c, a), sub(d, a));
+  return {0.5 * n[0], 0.5 * n[1], 0.5 * n[2]};
+}
+
+// ---- shrinking ball ---------------------------------------------------------------------------
+
+/// Medial-ball radii along +/- the vertex normals; `inward` picks the side.
+std::vector<double> ball_radii(const Boundary& b, bool inward) {
+  check_dim(b, inward ? "inscribed_radii" : "exterior_radii");
+  const detail::FacetTree tree(b, {}, false);
+  const int dim = b.dim;
+  const std::int64_t n_points = b.n_points(), n_facets = b.n_facets();
+  const double cap = tree.bbox_diagonal();
+
+  // Two vertex normals; which one is used depends on whether the vertex is a corner.
+  //  - smooth: Max's weights (N. Max, J. Graphics Tools 4(2), 1999), the facet normal divided by
+  //    the squared lengths of the facet's edges at the vertex (one edge in 2D): exact whenever the
+  //    vertex and its neighbours lie on a common circle / sphere. The area-weighted normal is off
+  //    by about 1 degree on an icosphere, which shrinks its balls to 0.8 R (measured): the balls
+  //    are tangent to the normal, so a tilt lets the nearby samples in.
+  //  - corner: unit facet normals weighted by the facet angle at the vertex (1 in 2D), the
+  //    bisector whatever the lengths of the sides; Max's weights would follow the shorter side.
+  std::vector<Vec> smooth_normal(std::size_t(n_points), Vec{0, 0, 0});
+  std::vector<Vec> corner_normal(std::size_t(n_points), Vec{0, 0, 0});
+  std::vector<Vec> unit_normal(static_cast<std::size_t>(n_facets));
+  std::vector<double> diameter(std::size_t(n_facets), 0.0);
+  std::vector<std::int64_t> start(std::size_t(n_points) + 1, 0), incident;  // point -> facets
+  for (std::int64_t f = 0; f < n_facets; ++f) {
+    const Vec n = facet_normal(b, f);
+    const double len = std::sqrt(norm2(n));
+    const Vec u = len > 0 ? Vec{n[0] / len, n[1] / len, n[2] / len} : Vec{0, 0, 0};
+    unit_normal[std::size_t(f)] = u;
+    const auto v = b.facet(f);
+    for (int i = 0; i < dim; ++i) {
+      const auto vi = std::size_t(v[std::size_t(i)]);
+      const Vec x = point3(b, std::int64_t(vi));
+      ++start[vi + 1];
+      const Vec e1 = sub(point3(b, v[std::size_t((i + 1) % dim)]), x);
+      const Vec e2 = dim == 3 ? sub(point3(b, v[std::size_t((i + 2) % dim)]), x) : e1;
+      const double weight = dim == 3 ? norm2(e1) * norm2(e2) : norm2(e1);
+      const double angle =
+          dim == 3 ? std::atan2(std::sqrt(norm2(cross(e1, e2))), dot(e1, e2)) : 1.0;
+      for (int k = 0; k < 3; ++k) {
+        if (weight > 0) smooth_normal[vi][std::size_t(k)] += n[std::size_t(k)] / weight;
+        corner_normal[vi][std::size_t(k)] += angle * u[std::size_t(k)];
+      }
+      for (int j = i + 1; j < dim; ++j)
+        diameter[std::size_t(f)] =
+            std::max(diameter[std::size_t(f)], norm2(sub(x, point3(b, v[std::size_t(j)]))));
+    }
+    diameter[std::size_t(f)] = std::sqrt(diameter[std::size_t(f)]);
+  }
+  for (std::int64_t i = 0; i < n_points; ++i) start[std::size_t(i) + 1] += start[std::size_t(i)];
+  incident.resize(std::size_t(start.back()));
+  {
+    std::vector<std::int64_t> fill(start.begin(), start.end() - 1);
+    for (std::int64_t f = 0; f < n_facets; ++f)
+      for (const int v : b.facet(f)) incident[std::size_t(fill[std::size_t(v)]++)] = f;
+  }
+  const auto incident_to = [&](std::int64_t i) {
+    return std::span<const std::int64_t>(incident.data() + start[std::size_t(i)],
+                                         incident.data() + start[std::size_t(i) + 1]);
+  };
+
+  // Flat regions: maximal sets of facets, connected through shared vertices (2D) / edges (3D),
+  // with the same normal (the straight side of a polygon, the face of a box). The regions of the
+  // facets at p are ignored, not only those facets: where the boundary is smooth at p they are
+  // tangent to every candidate ball anyway, and at a convex corner (where the exact medial ball
+  // is 0) the ball then grows along the bisector until it meets the rest of the shape, the same
+  // for any sampling of the sides.
+  std::vector<std::int64_t> region(static_cast<std::size_t>(n_facets));
+  for (std::int64_t f = 0; f < n_facets; ++f) region[std::size_t(f)] = f;
+  const auto find = [&](std::int64_t f) {
+    while (region[std::size_t(f)] != f)
+      f = region[std::size_t(f)] = region[std::size_t(region[std::size_t(f)])];
+    return f;
+  };
+  for (std::int64_t f = 0; f < n_facets; ++f) {
+    const auto v = b.facet(f);
+    for (int i = 0; i < dim; ++i) {
+      const int a = v[std::size_t(i)], c = v[std::size_t((i + 1) % dim)];
+      for (const std::int64_t g : incident_to(a)) {
+        if (g <= f) continue;
+        const auto w = b.facet(g);
+        if (dim == 3 && std::find(w.begin(), w.end(), c) == w.end()) continue;  // no shared edge
+        if (dot(unit_normal[std::size_t(f)], unit_normal[std::size_t(g)]) < 1 - 1e-12) continue;
+        region[std::size_t(find(f))] = find(g);
+      }
+    }
+  }
+  for (std::int64_t f = 0; f < n_facets; ++f) region[std::size_t(f)] = find(f);
+
+  // A facet whose vertices are all outside (or on) the ball and that is short compared to the
+  // radius cuts into the ball by at most its sagitta: r (1 - sqrt(1 - beta^2 / 4)) <= r / 32 for
+  // beta = 1/2. That is how a sampled circle or sphere looks from its centre (an icosphere with
+  // 320 triangles has facets of 0.35 R), so it does not shrink the ball. A longer facet does:
+  // then the polygon/surface itself is the shape.
+  constexpr double beta = 0.5;
+  constexpr double rel_tol = 1e-9;  // contacts within this relative depth count as touching
+
+  std::vector<double> radii(std::size_t(n_points), std::numeric_limits<double>::quiet_NaN());
+  std::vector<std::int64_t> own_regions;
+  for (std::int64_t i = 0; i < n_points; ++i) {
+    // A corner: two facets at p whose normals differ by more than 30 degrees.
+    bool corner = false;
+    const auto at_p = incident_to(i);
+    for (std::size_t a = 0; a < at_p.size() && !corner; ++a)
+      for (std::size_t c = a + 1; c < at_p.size() && !corner; ++c)
+        corner = dot(unit_normal[std::size_t(at_p[a])], unit_normal[std::size_t(at_p[c])]) <
+                 std::cos(std::numbers::pi / 6);
+    Vec n = corner ? corner_normal[std::size_t(i)] : smooth_normal[std::size_t(i)];
+    const double len = std::sqrt(norm2(n));
+    if (!(len > 0)) continue;  // on no facet (or a degenerate fan)
+    const double s = (inward ? -1.0 : 1.0) / len;
+    for (double& component : n) component *= s;
+    const Vec p = point3(b, i);
+    std::vector<std::int64_t>& own = own_regions;
+    own.clear();
+    for (const std::int64_t f : incident_to(i)) own.push_back(region[std::size_t(f)]);
+
+    double r = cap;
+    for (int iter = 0; iter < 100 && r > 0; ++iter) {
+      const Vec c = {p[0] + r * n[0], p[1] + r * n[1], p[2] + r * n[2]};
+      const double inner2 = (r * (1 - rel_tol)) * (r * (1 - rel_tol));
+      const auto skip = [&](std::int64_t f) {
+        if (std::find(own.begin(), own.end(), region[std::size_t(f)]) != own.end()) return true;
+        if (diameter[std::size_t(f)] > beta * r) return false;
+        for (const int w : b.facet(f))
+          if (norm2(sub(point3(b, w), c)) < inner2) return false;
+        return true;
+      };
+      const detail::ClosestHit hit = tree.closest_if(c.data(), inner2, skip);
+      if (hit.facet < 0) break;  // the ball is empty: done
+      // A short facet stands for its vertices, the samples of the shape: the ball shrinks to
+      // exclude the vertex that is inside it, not the chord (which lies inside the sampled
+      // surface by its sagitta, and would make the ball at a point of high curvature too small).
+      Vec q = hit.point;
+      if (diameter[std::size_t(hit.facet)] <= beta * r) {
+        double best = HUGE_VAL;
+        for (const int w : b.facet(hit.facet)) {
+          const Vec x = point3(b, w);
+          if (const double d2 = norm2(sub(x, c)); d2 < best) best = d2, q = x;
+        }
+      }
+      const Vec pq = sub(q, p);
+      const double denom = 2 * dot(n, pq);
+      // |c - q| < r implies n.(q - p) > |q - p|^2 / (2 r) > 0; a non-positive value is round-off
+      // for q at p: the boundary touches itself there.
+      const double r_new = denom > 0 ? norm2(pq) / denom : 0.0;
+      if (!(r_new < r)) break;
+      const bool converged = r - r_new <= 1e-12 * r;
+      r = r_new;
+      if (converged) break;
+    }
+    radii[std::size_t(i)] = r;
+  }
+  return radii;
+}
+
+// ---- Hausdorff --------------------------------------------------------------------------------
+
+double directed_hausdorff_impl(const Boundary& from, const detail::FacetTree& to,
+                               double tolerance) {
+  const int dim = from.dim;
+  detail::ClosestHit hit;
+  const auto closest = [&](const Vec& x) {
+    hit = hit.facet < 0 ? to.closest(x.data()) : to.closest(x.data(), hit);
+    return std::pair{std::sqrt(hit.squared_distance), hit.primitive};
+  };
+
+  // Lower bound from the vertices first, so that most facets are pruned at once.
+  const std::int64_t n_points = from.n_points();
+  std::vector<double> d_point(std::size_t(n_points), 0.0);
+  std::vector<std::int64_t> f_point(std::size_t(n_points), -1);
+  double lower = 0;
+  for (const int i : from.facets) {
+    if (f_point[std::size_t(i)] >= 0) continue;
+    std::tie(d_point[std::size_t(i)], f_point[std::size_t(i)]) = closest(point3(from, i));
+    lower = std::max(lower, d_point[std::size_t(i)]);
+  }
+
+  // A simplex of `from`: vertices, their distances to `to` and the facet of `to` realising it.
+  struct Simplex {
+    std::array<Vec, 3> x;
+    std::array<double, 3> d;
+    std::array<std::int64_t, 3> f;
+  };
+  // Upper bound of dist(., to) over the simplex. Two bounds, both valid for every x in it:
+  //  - Lipschitz: dist(x) <= d_i + |x - v_i| <= d_i + max_j |v_j - v_i|;
+  //  - convexity: dist(x) <= dist(x, F_i) for the facet F_i closest to v_i, and dist(., F_i) is
+  //    convex, so its max over the simplex is at a vertex. This one is tight where the two
+  //    boundaries run parallel (a shape and its offset), where Lipschitz alone would bisect
+  //    every facet down to the tolerance.
+  const auto upper_bound = [&](const Simplex& t, double& diam2, int& e0, int& e1) {
+    double upper = std::numeric_limits<double>::infinity();
+    diam2 = 0, e0 = 0, e1 = 1;
+    for (int a = 0; a < dim; ++a) {
+      double far2 = 0, convex2 = 0;
+      for (int c = 0; c < dim; ++c) {
+        const double l2 = norm2(sub(t.x[std::size_t(a)], t.x[std::size_t(c)]));
+        far2 = std::max(far2, l2);
+        if (l2 > diam2) diam2 = l2, e0 = a, e1 = c;
+        convex2 = std::max(convex2, c == a ? t.d[std::size_t(a)] * t.d[std::size_t(a)]
+                                           : to.squared_distance_to(t.x[std::size_t(c)].data(),
+                                                                    t.f[std::size_t(a)]));
+      }
+      upper = std::min({upper, t.d[std::size_t(a)] + std::sqrt(far2), std::sqrt(convex2)});
+    }
+    return upper;
+  };
+
+  std::vector<Simplex> stack;
+  for (std::int64_t f = 0; f < from.n_facets(); ++f) {
+    const auto v = from.facet(f);
+    Simplex s{};
+    for (int k = 0; k < dim; ++k) {
+      const auto i = std::size_t(v[std::size_t(k)]);
+      s.x[std::size_t(k)] = point3(from, std::int64_t(i));
+      s.d[std::size_t(k)] = d_point[i];
+      s.f[std::size_t(k)] = f_point[i];
+    }
+    stack.push_back(s);
+    while (!stack.empty()) {
+      const Simplex t = stack.back();
+      stack.pop_back();
+      double diam2 = 0;
+      int e0 = 0, e1 = 1;
+      const double upper = upper_bound(t, diam2, e0, e1);
+      // Pruned either because it cannot beat `lower`, or because upper <= max_i d_i + diam <=
+      // lower + tolerance: the guarantee of the header.
+      if (upper <= lower || std::sqrt(diam2) <= tolerance) continue;
+      const Vec m = midpoint(t.x[std::size_t(e0)], t.x[std::size_t(e1)]);
+      const auto [dm, fm] = closest(m);
+      lower = std::max(lower, dm);
+      Simplex c0 = t, c1 = t;  // bisect the longest edge
+      c0.x[std::size_t(e0)] = m, c0.d[std::size_t(e0)] = dm, c0.f[std::size_t(e0)] = fm;
+      c1.x[std::size_t(e1)] = m, c1.d[std::size_t(e1)] = dm, c1.f[std::size_t(e1)] = fm;
+      stack.push_back(c0);
+      stack.push_back(c1);
+    }
+  }
+  return lower;
+}
+
+void check_pair(const Boundary& a, const Boundary& b, double tolerance, const char* what) {
+  check_dim(a, what);
+  check_dim(b, what);
+  if (a.dim != b.dim)
+    throw std::invalid_argument(std::string(what) + ": boundaries of dimensions " +
+                                std::to_string(a.dim) + " and " + std::to_string(b.dim));
+  if (!(tolerance > 0))
+    throw std::invalid_argument(std::string(what) + ": tolerance must be > 0, got " +
+                                std::to_string(tolerance));
+}
+
+}  // namespace
+
+double enclosed_measure(const Boundary& b) {
+  check_dim(b, "enclosed_measure");
+  double sum = 0;
+  for (std::int64_t f = 0; f < b.n_facets(); ++f) {
+    const auto v = b.facet(f);
+    const Vec p = point3(b, v[0]), q = point3(b, v[1]);
+    if (b.dim == 2) {
+      sum += p[0] * q[1] - p[1] * q[0];
+    } else {
+      sum += dot(p, cross(q, point3(b, v[2])));
+    }
+  }
+  return sum / (b.dim == 2 ? 2.0 : 6.0);
+}
+
+double boundary_measure(const Boundary& b) {
+  check_dim(b, "boundary_measure");
+  double sum = 0;
+  for (std::int64_t f = 0; f < b.n_facets(); ++f) sum += std::sqrt(norm2(facet_normal(b, f)));
+  return sum;
+}
+
+double isoperimetric_ratio(const Boundary& b) {
+  if (b.dim != 2)
+    throw std::invalid_argument("isoperimetric_ratio: only for 2D boundaries, got dimension " +
+                                std::to_string(b.dim));
+  const double p = boundary_measure(b);
+  return 4 * std::numbers::pi * enclosed_measure(b) / (p * p);
+}
+
+double directed_hausdorff_distance(const Boundary& from, const Boundary& to, double tolerance) {
+  check_pair(from, to, tolerance, "directed_hausdorff_distance");
+  const detail::FacetTree tree(to, {}, false);
+  return directed_hausdorff_impl(from, tree, tolerance);
+}
+
+double hausdorff_distance(const Boundary& a, const Boundary& b, double tolerance) {
+  check_pair(a, b, tolerance, "hausdorff_distance");
+  const detail::FacetTree tree_a(a, {}, false), tree_b(b, {}, false);
+  return std::max(directed_hausdorff_impl(a, tree_b, tolerance),
+                  directed_hausdorff_impl(b, tree_a, tolerance));
+}
+
+std::vector<double> inscribed_radii(const Boundary& b) { return ball_radii(b, true); }
+std::vector<double> exterior_radii(const Boundary& b) { return ball_radii(b, false); }
+
+ShapeMetrics compute_metrics(const Boundary& shape, const Boundary* base,
+                             double hausdorff_tolerance) {
+  check_dim(shape, "compute_metrics");
+  const auto min_of = [](const std::vector<double>& v) {
+    double m = std::numeric_limits<double>::quiet_NaN();
+    for (const double x : v) m = std::fmin(m, x);  // fmin skips NaN
+    return m;
+  };
+  ShapeMetrics m;
+  m.measure = enclosed_measure(shape);
+  m.boundary_measure = boundary_measure(shape);
+  m.isoperimetric_ratio =
+      shape.dim == 2 ? 4 * std::numbers::pi * m.measure / (m.boundary_measure * m.boundary_measure)
+                     : std::numeric_limits<double>::quiet_NaN();
+  m.hausdorff_to_base = base ? hausdorff_distance(shape, *base, hausdorff_tolerance)
+                             : std::numeric_limits<double>::quiet_NaN();
+  m.n_boundary_facets = shape.n_facets();
+  m.min_local_feature_size = min_of(inscribed_radii(shape));
+  m.min_exterior_gap = min_of(exterior_radii(shape));
+  return m;
+}
+
+}  // namespace hypershape::geometry
