@@ -10,7 +10,8 @@ For every file (root attribute `name` = NAME) it writes
       2D: the filled boundary polygon, the Dirichlet patch facets drawn thick in another
           colour and p_D as a dot; axes [-1.05, 1.05]^2, equal aspect; title "id, iso ratio".
       3D: the boundary surface (Poly3DCollection, shaded by the facet normal), the Dirichlet
-          patch facets in another colour and p_D as a dot; title "id, Hausdorff to base".
+          patch facets in another colour, seen from p_D's side (30 degrees off, so the patch
+          is in view); box [-1, 1]^3; title "id, Hausdorff distance to the base".
       A failed shape (attribute failed == 1) is an empty panel labelled "failed".
   OUT_DIR/NAME_histogram.png  the isoperimetric ratio (2D) / the Hausdorff distance to the base
                               (3D) over ALL non-failed shapes in the file
@@ -35,7 +36,6 @@ BODY = "#9ecae1"       # shape fill (2D) / surface (3D)
 EDGE = "#3182bd"       # 2D boundary line
 PATCH = "#d62728"      # Dirichlet patch facets
 CENTER = "#000000"     # p_D
-LIGHT = np.array([0.4, -0.5, 0.75])
 
 
 def text_attr(v):
@@ -124,10 +124,10 @@ def draw_2d(ax, s):
     ax.set_title(f"#{s['id']}  iso {metric(s, 2):.3f}", fontsize=8)
 
 
-def shade(rgb, normals):
-    light = LIGHT / np.linalg.norm(LIGHT)
+def shade(rgb, normals, light):
     lam = np.clip(normals @ light, 0.0, 1.0)
-    return np.clip(np.asarray(matplotlib.colors.to_rgb(rgb))[None, :] * (0.45 + 0.55 * lam[:, None]), 0, 1)
+    base = np.asarray(matplotlib.colors.to_rgb(rgb))[None, :]
+    return np.clip(base * (0.35 + 0.65 * lam[:, None]), 0, 1)
 
 
 def draw_3d(ax, s):
@@ -135,19 +135,31 @@ def draw_3d(ax, s):
     tri = pts[fac]  # m x 3 x 3
     n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
-    colors = shade(BODY, n)
+    # Look at the shape from p_D's side, lit from the camera and above.
+    c = np.asarray(s["attrs"].get("dirichlet_center", [0.0, 0.0, 0.0]), dtype=float)
+    has_patch = s["attrs"].get("dirichlet_radius", 0) > 0 and np.linalg.norm(c) > 1e-9
+    if has_patch:
+        u = c / np.linalg.norm(c)
+        azim, elev = np.degrees(np.arctan2(u[1], u[0])), np.degrees(np.arcsin(np.clip(u[2], -1, 1)))
+        # 30 degrees off p_D's direction: the patch in view, the silhouette still telling.
+        azim, elev = azim + 30.0, float(np.clip(elev + 15.0, -60.0, 60.0))
+    else:
+        azim, elev = -60.0, 20.0
+    a, e = np.radians(azim), np.radians(elev)
+    eye = np.array([np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)])
+    light = eye + 0.5 * np.array([0.0, 0.0, 1.0]) - 0.3 * np.array([-np.sin(a), np.cos(a), 0.0])
+    light /= np.linalg.norm(light)
+    colors = shade(BODY, n, light)
     dfac = s["dirichlet_facets"].astype(int)
     if dfac.size:
-        colors[dfac] = shade(PATCH, n[dfac])
-    coll = Poly3DCollection(tri, facecolors=colors, edgecolors="none", linewidths=0)
+        colors[dfac] = shade(PATCH, n[dfac], light)
+    # Edges in the face colour hide the anti-aliasing seams between triangles.
+    coll = Poly3DCollection(tri, facecolors=colors, edgecolors=colors, linewidths=0.2)
     ax.add_collection3d(coll)
-    c = np.asarray(s["attrs"].get("dirichlet_center", [np.nan] * 3), dtype=float)
-    if s["attrs"].get("dirichlet_radius", 0) > 0:
-        ax.scatter([c[0]], [c[1]], [c[2]], color=CENTER, s=6, depthshade=False)
     for set_lim in (ax.set_xlim, ax.set_ylim, ax.set_zlim):
         set_lim(-1.0, 1.0)
-    ax.set_box_aspect((1, 1, 1))
-    ax.view_init(elev=20, azim=-60)
+    ax.set_box_aspect((1, 1, 1), zoom=1.35)
+    ax.view_init(elev=elev, azim=azim)
     ax.set_axis_off()
     ax.set_title(f"#{s['id']}  Hausdorff {metric(s, 3):.3f}", fontsize=8)
 
@@ -171,7 +183,7 @@ def gallery(name, dim, shapes, path, n_max):
             draw_3d(ax, s)
     ids = (f"shapes {shown[0]['id']}..{shown[-1]['id']}" if len(shown) > 1
            else f"shape {shown[0]['id']}")
-    what = "Dirichlet patch red, p_D dot" if cols > 1 else "patch red"
+    what = "Dirichlet patch red" + (", p_D dot" if dim == 2 else "") if cols > 1 else "patch red"
     fig.suptitle(f"{name}: {ids} ({what})", fontsize=12 if cols > 1 else 9)
     fig.tight_layout(rect=(0, 0, 1, 1 - 0.45 / (3.15 * rows + 0.45)))
     fig.savefig(path, dpi=90)
