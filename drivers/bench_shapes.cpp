@@ -122,6 +122,29 @@ std::string fmt_time(double s) {
 
 std::string fmt_count(double v) { return std::isfinite(v) ? fmt::format("{:.0f}", v) : "-"; }
 
+/// "N attempts: stage k, ... (first: reason)" from make_shape's failure message, whose lines
+/// after the first read "  attempt A (stage): reason".
+std::string summarise_failure(const std::string& what) {
+  std::map<std::string, int> stages;
+  std::string first;
+  int n = 0;
+  std::size_t pos = what.find('\n');
+  while (pos != std::string::npos) {
+    const std::size_t end = what.find('\n', pos + 1);
+    const std::string line = what.substr(pos + 1, end == std::string::npos ? end : end - pos - 1);
+    pos = end;
+    const std::size_t open = line.find('('), close = line.find("): ");
+    if (open == std::string::npos || close == std::string::npos || close < open) continue;
+    ++n;
+    ++stages[line.substr(open + 1, close - open - 1)];
+    if (first.empty()) first = line.substr(close + 3);
+  }
+  if (n == 0) return what.substr(0, what.find('\n'));
+  std::string out = fmt::format("{} attempts:", n);
+  for (const auto& [stage, k] : stages) out += fmt::format(" {} {}", stage, k);
+  return out + " (first: " + first + ")";
+}
+
 /// The preset's base file, if it names one that does not exist (checked before any work).
 std::optional<std::string> missing_base(const hs::config::DatasetConfig& cfg) {
   if (cfg.shapes.base != "file") return std::nullopt;
@@ -150,7 +173,7 @@ void run_preset(const Settings& set, const hs::config::DatasetConfig& cfg, Prese
       s["failed_make_shape"].push_back(hs::core::now_seconds() - t0);
       v["failed_shape_id"].push_back(id);
       rec.notes.push_back(fmt::format("shape {} failed after {:.1f}s: {}", id,
-                                      hs::core::now_seconds() - t0, what.substr(0, what.find('\n'))));
+                                      hs::core::now_seconds() - t0, summarise_failure(what)));
       std::cerr << fmt::format("[bench] {} shape {}/{} FAILED\n", rec.name, id + 1, rec.repeats);
       continue;
     }
@@ -369,6 +392,9 @@ int main(int argc, char** argv) {
       out["machine"]["load_average_end"] = load_average();
       if (!set.json_path.empty()) write_json_atomic(set.json_path, out);
     }
+    out["total_seconds"] = hs::core::now_seconds() - t_all;
+    out["machine"]["load_average_end"] = load_average();
+    if (!set.json_path.empty()) write_json_atomic(set.json_path, out);  // skips after the last run
     print_table(std::cout, recs);
     for (const auto& s : out["skipped"])
       std::cout << fmt::format("skipped {}: {}\n", s["file"].get<std::string>(),

@@ -15,8 +15,9 @@
 #   NP               MPI ranks (default 2; 1 runs without mpiexec)
 #   N2D, N3D         shapes per 2D / 3D preset (default 200 / 30; at least 16 for the gallery)
 #   PRESETS          preset names (default: all six)
-#   PRESET_TIMEOUT   seconds per preset, 0 = none (default 0); a preset that runs out is
-#                    reported and skipped (no file is written by a killed run)
+#   PRESET_TIMEOUT   seconds per preset, 0 = none (default 900); a preset that runs out is
+#                    reported and skipped (a killed run writes no file). A 3D shape whose every
+#                    draw fails can take ~8 min (20 attempts), hence the cap.
 #   SHAPES_DIR       where the .h5 files and the CLI logs go (default results/shapes; ignored)
 #   OUT_DIR          figures (default docs/figures)
 set -euo pipefail
@@ -28,7 +29,7 @@ NP="${NP:-2}"
 N2D="${N2D:-200}"
 N3D="${N3D:-30}"
 PRESETS="${PRESETS:-random2d easy_random2d ood_random2d one_random2d random3d aug_liver}"
-PRESET_TIMEOUT="${PRESET_TIMEOUT:-0}"
+PRESET_TIMEOUT="${PRESET_TIMEOUT:-900}"
 SHAPES_DIR="${SHAPES_DIR:-results/shapes}"
 OUT_DIR="${OUT_DIR:-docs/figures}"
 PY=/usr/bin/python3
