@@ -17,6 +17,7 @@
 
 #include "hypershape/mesh/gmsh_mesher.hpp"
 #include "hypershape/mesh/quality.hpp"
+#include "gmsh_util.hpp"
 
 namespace hypershape::mesh {
 
@@ -257,27 +258,7 @@ class GradedSize {
 
 // ---- gmsh state ----------------------------------------------------------------------------
 
-/// A model of our own for one call, inside a session opened for the call if none is alive.
-/// TODO(unify): same as ScopedModel in gmsh_mesher.cpp.
-class ScopedModel {
- public:
-  explicit ScopedModel(const std::string& name) {
-    if (!GmshSession::active()) own_.emplace();
-    gmsh::model::add(name);
-    gmsh::model::setCurrent(name);
-  }
-  ScopedModel(const ScopedModel&) = delete;
-  ScopedModel& operator=(const ScopedModel&) = delete;
-  ~ScopedModel() {
-    try {
-      gmsh::model::remove();
-    } catch (...) {
-    }
-  }
-
- private:
-  std::optional<GmshSession> own_;
-};
+using detail::ScopedModel;
 
 /// Sets gmsh options for one call and restores the previous values on exit: gmsh options are
 /// process-global, and the other meshers do not set everything we change (e.g. smoothing).
