@@ -9,4 +9,4 @@ export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
 args=("$@")
 [ ${#args[@]} -eq 0 ] && args=(-LE slow)
 cd "${BUILD_DIR:-build}"
-ctest --output-on-failure --parallel "$(nproc)" "${args[@]}"
+ctest --no-tests=error --output-on-failure --parallel "$(nproc)" "${args[@]}"
