@@ -3,12 +3,16 @@
 ///   hypershape solve [SCENE.yaml] -o OUT.h5     one scene (default: the embedded one)
 ///   hypershape shapes CONFIG.yaml -o SHAPES.h5  random shapes of a dataset config (meshes,
 ///                                               Dirichlet patches, metrics); MPI-parallel
+///   hypershape generate [DATASET.yaml] [-o DIR]  a dataset (default: the embedded small one);
+///                                               MPI solver groups, SLURM arrays, resume
+///   hypershape index DIR                        manifest, splits, statistics, XDMF of a dataset
 ///   hypershape effects                          lists the effects a scene may use
 ///
 /// PETSc options (-snes_monitor, -pc_type ..., -log_view) pass through to PETSc.
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 
@@ -17,6 +21,9 @@
 #include "hypershape/core/error.hpp"
 #include "hypershape/core/log.hpp"
 #include "hypershape/core/petsc_handle.hpp"
+#include "hypershape/core/collective.hpp"
+#include "hypershape/factory/dataset_index.hpp"
+#include "hypershape/factory/generate.hpp"
 #include "hypershape/factory/shape_set.hpp"
 #include "hypershape/factory/solve_scene.hpp"
 #include "hypershape/io/shape_file.hpp"
@@ -60,6 +67,27 @@ int run(int argc, char** argv) {
   shapes->add_option("--first", first, "first shape id")->check(CLI::NonNegativeNumber);
   shapes->add_option("-n,--count", count, "number of shapes (default: shapes.count - first)");
   shapes->allow_extras();
+  auto* generate = app.add_subcommand("generate", "generate a dataset (shards, manifest, splits, statistics)");
+  std::string gen_config, gen_out;
+  factory::GenerateOptions gen;
+  auto env_int = [](const char* name, int fallback) {
+    const char* v = std::getenv(name);
+    return v && *v ? std::atoi(v) : fallback;
+  };
+  // SLURM array defaults: the task's offset in the array and the array's size.
+  gen.task_index = env_int("SLURM_ARRAY_TASK_ID", 0) - env_int("SLURM_ARRAY_TASK_MIN", 0);
+  gen.task_count = env_int("SLURM_ARRAY_TASK_COUNT", 1);
+  generate->add_option("config", gen_config, "dataset config (YAML); default: the embedded small dataset");
+  generate->add_option("-o,--output", gen_out, "output directory (default: results/<name>)");
+  generate->add_option("--task-index", gen.task_index, "this task's slice (default: $SLURM_ARRAY_TASK_ID - $SLURM_ARRAY_TASK_MIN)");
+  generate->add_option("--task-count", gen.task_count, "number of slices (default: $SLURM_ARRAY_TASK_COUNT or 1)");
+  generate->add_option("--group-size", gen.group_size, "ranks per shape (default 1)");
+  generate->add_option("--progress", gen.progress_seconds, "seconds between progress lines (0: none)");
+  generate->allow_extras();
+  auto* index = app.add_subcommand("index", "write the manifest, splits, statistics and XDMF of a dataset directory");
+  std::string index_dir;
+  index->add_option("dir", index_dir, "dataset directory")->required();
+  index->allow_extras();
   auto* effects = app.add_subcommand("effects", "list the effects a scene may use");
   effects->allow_extras();
 
@@ -74,6 +102,30 @@ int run(int argc, char** argv) {
   if (*effects) {
     for (auto& [name, help] : physics::registered_effects()) core::info(comm, "{:20s} {}", name, help);
     return 0;
+  }
+  if (*generate) {
+    mesh::GmshSession gmsh;
+    const config::DatasetConfig cfg =
+        gen_config.empty() ? config::parse_dataset_text(config::default_dataset_text(), "<default dataset>")
+                           : config::parse_dataset_file(gen_config);
+    gen.output_dir = gen_out.empty() ? "results/" + cfg.name : gen_out;
+    const auto report = factory::generate(comm, cfg, gen);
+    core::info(comm, "[generate] done{}:\n{}", report.indexed ? " (dataset complete: manifest, splits, stats written)"
+                                                               : " (slice written; run `hypershape index` when all are)",
+               factory::report_table(report));
+    return 0;
+  }
+  if (*index) {
+    factory::IndexReport r;
+    core::on_root(comm, [&] { r = factory::index_dataset(index_dir); });
+    std::string missing;
+    for (auto k : r.missing_shards) missing += (missing.empty() ? "" : ", ") + std::to_string(k);
+    core::info(comm, "{}: {} shards, {} shapes ({} failed), {} load cases converged, {} failed{}", index_dir,
+               r.shards, r.shapes_ok + r.shapes_failed, r.shapes_failed, r.loads_ok, r.loads_failed,
+               r.complete() ? "; complete" : "; INCOMPLETE, missing shards: " + missing);
+    int complete = r.complete();
+    MPI_Bcast(&complete, 1, MPI_INT, 0, comm);
+    return complete ? 0 : 4;
   }
   if (*shapes) {
     check_output_path(shapes_out);
@@ -125,6 +177,8 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     std::fprintf(stderr, "[rank %d] error: %s\n", core::rank(PETSC_COMM_WORLD), e.what());
     code = 1;
+    // Other ranks may wait in a collective for this one: stop them all.
+    if (core::size(PETSC_COMM_WORLD) > 1) MPI_Abort(PETSC_COMM_WORLD, code);
   }
   return code;
 }

@@ -1,16 +1,18 @@
 #include "hypershape/config/dataset.hpp"
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
+#include "solver_block.hpp"
 #include "yaml_block.hpp"
 
 namespace hypershape::config {
 
 namespace {
 
-void parse_shapes(YamlBlock& b, const std::string& base_dir, factory::ShapeConfig& s,
+void parse_shapes(const YamlBlock& b, const std::string& base_dir, factory::ShapeConfig& s,
                   std::int64_t& count) {
   const long n = b.integer("count");
   if (n < 1) b.fail("count", "must be >= 1");
@@ -90,10 +92,69 @@ void parse_shapes(YamlBlock& b, const std::string& base_dir, factory::ShapeConfi
   b.check_all_used();
 }
 
+/// Merges `over` into `base`: mappings key by key (recursively), anything else replaced.
+YAML::Node merge(const YAML::Node& base, const YAML::Node& over) {
+  if (!base || !base.IsMap() || !over || !over.IsMap()) return YAML::Clone(over);
+  YAML::Node out = YAML::Clone(base);
+  for (const auto& kv : over) {
+    const std::string k = kv.first.Scalar();
+    out[k] = merge(out[k], kv.second);
+  }
+  return out;
+}
+
+void parse_loads(const YamlBlock& b, LoadsConfig& l) {
+  if (b.has("count")) {
+    const long n = b.integer("count");
+    if (n < 1 || n > 1000000) b.fail("count", "must be in [1, 1000000] (load cases per shape)");
+    l.count = int(n);
+  }
+  if (b.has("gamma")) l.gamma = b.number("gamma");
+  if (!(l.gamma >= 0.005 && l.gamma <= 2.0)) b.fail("gamma", "must be in [0.005, 2]");
+  if (b.has("target")) {
+    const auto t = b.vector("target", 2);
+    l.target_min = t[0];
+    l.target_max = t[1];
+  }
+  if (!(l.target_min > 0 && l.target_min <= l.target_max && l.target_max <= 2.0))
+    b.fail("target", "must be [min, max] with 0 < min <= max <= 2 (max|u| in the box [-1, 1]^d)");
+  b.allowed("count, gamma, target");
+  b.check_all_used();
+}
+
+void parse_material(const YamlBlock& b, MaterialConfig& m) {
+  if (b.has("E")) m.E = b.number("E");
+  if (!(m.E > 0)) b.fail("E", "must be > 0");
+  if (b.has("nu")) m.nu = b.number("nu");
+  if (!(m.nu > -1 && m.nu < 0.5)) b.fail("nu", "must be in (-1, 0.5)");
+  b.allowed("E, nu");
+  b.check_all_used();
+}
+
+bool flag(const YamlBlock& b, const std::string& key, bool fallback) {
+  if (!b.has(key)) return fallback;
+  try {
+    return b.get(key).as<bool>();
+  } catch (const YAML::Exception&) {
+    b.fail(key, "must be true or false");
+  }
+}
+
 }  // namespace
 
+const char* default_dataset_text() {
+  return R"(# The embedded default dataset: a small slice of Random2D (seed paper, Table 1).
+preset: random2d
+name: default
+shapes: {count: 4, h: 0.06}
+loads: {count: 6}
+representations: {grid_size: 64}
+output: {shard_size: 2}
+)";
+}
+
 DatasetConfig parse_dataset_text(const std::string& text, const std::string& source,
-                                 const std::string& base_dir) {
+                                 const std::string& base_dir_in) {
   YAML::Node root;
   try {
     root = YAML::Load(text);
@@ -103,7 +164,24 @@ DatasetConfig parse_dataset_text(const std::string& text, const std::string& sou
   if (!root || !root.IsMap()) throw InputError(source, "", "a dataset config must be a YAML mapping");
   DatasetConfig c;
   c.source = source;
-  c.text = text;
+  std::string base_dir = base_dir_in;
+  if (root["preset"]) {
+    YamlBlock top(root, source, "");
+    c.preset = top.text("preset");
+    const Preset* found = nullptr;
+    std::string names;
+    for (const auto& p : presets()) {
+      names += (names.empty() ? "" : ", ") + std::string(p.name);
+      if (c.preset == p.name) found = &p;
+    }
+    if (!found) top.fail("preset", "unknown preset '" + c.preset + "'; presets: " + names);
+    YAML::Node base = YAML::Load(found->text);
+    root.remove("preset");
+    // A preset's relative paths (base_file) stay relative to the preset's directory unless the
+    // config gives its own.
+    if (!(root["shapes"] && root["shapes"]["base_file"])) base_dir = found->directory;
+    root = merge(base, root);
+  }
   YamlBlock top(root, source, "");
   c.name = top.text("name");
   if (c.name.empty() || c.name.find_first_of("/\\ \t") != std::string::npos)
@@ -112,11 +190,68 @@ DatasetConfig parse_dataset_text(const std::string& text, const std::string& sou
   if (seed < 0) top.fail("seed", "must be >= 0");
   c.seed = std::uint64_t(seed);
   if (!top.has("shapes")) top.fail("shapes", "missing (the shape family is required)");
-  YamlBlock shapes(top.get("shapes"), source, "shapes");
-  parse_shapes(shapes, base_dir, c.shapes, c.n_shapes);
+  parse_shapes(YamlBlock(top.get("shapes"), source, "shapes"), base_dir, c.shapes, c.n_shapes);
   c.shapes.name = c.name;
-  top.allowed("name, seed, shapes");
+  // The paper's widths: gamma 0.2 in 2D, 0.1 in 3D.
+  c.loads.gamma = c.shapes.dim == 2 ? 0.2 : 0.1;
+  parse_loads(YamlBlock(top.get("loads"), source, "loads"), c.loads);
+  parse_material(YamlBlock(top.get("material"), source, "material"), c.material);
+  {
+    YamlBlock m(top.get("mesh"), source, "mesh");
+    if (m.has("degree")) {
+      const long d = m.integer("degree");
+      if (d != 1 && d != 2) m.fail("degree", "must be 1 or 2");
+      c.degree = int(d);
+    }
+    m.allowed("degree (the element size is shapes.h)");
+    m.check_all_used();
+  }
+  {
+    YamlBlock r(top.get("representations"), source, "representations");
+    auto& rep = c.representations;
+    rep.point_cloud = flag(r, "point_cloud", true);
+    rep.grid = flag(r, "grid", true);
+    rep.grid_size = c.shapes.dim == 2 ? 128 : 64;
+    if (r.has("grid_size")) {
+      const long n = r.integer("grid_size");
+      if (n < 2 || n > (c.shapes.dim == 2 ? 4096 : 512))
+        r.fail("grid_size", c.shapes.dim == 2 ? "must be in [2, 4096]" : "must be in [2, 512]");
+      rep.grid_size = int(n);
+    }
+    r.allowed("point_cloud, grid, grid_size");
+    r.check_all_used();
+  }
+  {
+    YamlBlock s(top.get("split"), source, "split");
+    auto& sp = c.split;
+    if (s.has("train")) sp.train = s.number("train");
+    if (s.has("val")) sp.val = s.number("val");
+    if (s.has("test")) sp.test = s.number("test");
+    if (sp.train < 0 || sp.val < 0 || sp.test < 0 || std::abs(sp.train + sp.val + sp.test - 1.0) > 1e-9)
+      s.fail("", "train, val and test must be >= 0 and sum to 1");
+    s.allowed("train, val, test");
+    s.check_all_used();
+  }
+  {
+    YamlBlock o(top.get("output"), source, "output");
+    if (o.has("shard_size")) {
+      const long n = o.integer("shard_size");
+      if (n < 1 || n > 100000) o.fail("shard_size", "must be in [1, 100000] (shapes per shard)");
+      c.shard_size = int(n);
+    }
+    o.allowed("shard_size");
+    o.check_all_used();
+  }
+  parse_solver_block(YamlBlock(top.get("solver"), source, "solver"), c.solver);
+  parse_petsc_block(YamlBlock(top.get("petsc"), source, "petsc"), c.petsc);
+  top.allowed("preset, name, seed, shapes, loads, material, mesh, representations, split, output, solver, petsc");
   top.check_all_used();
+  // The resolved config, stored with the data: the preset merged in, paths made absolute.
+  if (!c.shapes.base_file.empty()) root["shapes"]["base_file"] = c.shapes.base_file;
+  YAML::Emitter e;
+  e << root;
+  c.text = std::string("# hypershape dataset config, resolved") +
+           (c.preset.empty() ? "" : " from preset " + c.preset) + "\n" + e.c_str() + "\n";
   return c;
 }
 

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "hypershape/core/error.hpp"
+#include "solver_block.hpp"
 #include "yaml_block.hpp"
 
 namespace hypershape::config {
@@ -129,26 +130,8 @@ Scene parse_scene_text(const std::string& text, const std::string& source, const
   load.allowed("alpha, target");
   load.check_all_used();
 
-  YamlBlock sol(top.get("solver"), source, "solver");
-  if (sol.has("rtol")) s.solver.rtol = sol.number("rtol");
-  if (!(s.solver.rtol > 0 && s.solver.rtol < 1)) sol.fail("rtol", "must be in (0, 1)");
-  if (sol.has("max_newton")) s.solver.max_newton = int(sol.integer("max_newton"));
-  if (s.solver.max_newton < 1) sol.fail("max_newton", "must be >= 1");
-  if (sol.has("max_increments")) s.solver.max_increments = int(sol.integer("max_increments"));
-  if (s.solver.max_increments < 1) sol.fail("max_increments", "must be >= 1");
-  if (sol.has("target_rtol")) s.solver.target_rtol = sol.number("target_rtol");
-  if (!(s.solver.target_rtol > 0 && s.solver.target_rtol < 1)) sol.fail("target_rtol", "must be in (0, 1)");
-  sol.allowed("rtol, max_newton, max_increments, target_rtol");
-  sol.check_all_used();
-
-  YamlBlock petsc(top.get("petsc"), source, "petsc");
-  if (petsc.node() && petsc.node().IsMap())
-    for (const auto& kv : petsc.node()) {
-      const std::string k = kv.first.Scalar();
-      petsc.get(k);
-      if (!kv.second.IsNull() && !kv.second.IsScalar()) petsc.fail(k, "must be a scalar value");
-      s.petsc.emplace_back("-" + k, kv.second.IsNull() ? "" : kv.second.Scalar());
-    }
+  parse_solver_block(YamlBlock(top.get("solver"), source, "solver"), s.solver);
+  parse_petsc_block(YamlBlock(top.get("petsc"), source, "petsc"), s.petsc);
   top.check_all_used();
   return s;
 }

@@ -94,14 +94,15 @@ class YamlBlock {
       if (!used_.count(k)) fail(k, "unknown key" + (allowed_.empty() ? "" : "; allowed: " + allowed_));
     }
   }
-  void allowed(std::string a) { allowed_ = std::move(a); }
+  void allowed(std::string a) const { allowed_ = std::move(a); }
   const YAML::Node& node() const { return node_; }
   const std::string& file() const { return file_; }
   const std::string& path() const { return path_; }
 
  private:
   YAML::Node node_;
-  std::string file_, path_, allowed_;
+  std::string file_, path_;
+  mutable std::string allowed_;
   mutable std::set<std::string> used_;
 };
 

@@ -37,44 +37,6 @@ void normalise_into_box(geometry::Boundary& b) {
     for (int a = 0; a < d; ++a) b.points[i + a] = (b.points[i + a] - 0.5 * (lo[a] + hi[a])) / half;
 }
 
-/// A point drawn uniformly (by length / area) on the facets of `b`.
-std::array<double, 3> uniform_boundary_point(const geometry::Boundary& b, core::RandomStream& rng) {
-  const int d = b.dim;
-  const std::int64_t n = b.n_facets();
-  std::vector<double> cumulative(std::size_t(n) + 1, 0.0);
-  for (std::int64_t f = 0; f < n; ++f) {
-    const auto v = b.facet(f);
-    const auto p = b.point(v[0]), q = b.point(v[1]);
-    double measure;
-    if (d == 2) {
-      measure = std::hypot(q[0] - p[0], q[1] - p[1]);
-    } else {
-      const auto r = b.point(v[2]);
-      const double u[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
-      const double w[3] = {r[0] - p[0], r[1] - p[1], r[2] - p[2]};
-      measure = 0.5 * std::sqrt(std::pow(u[1] * w[2] - u[2] * w[1], 2) +
-                                std::pow(u[2] * w[0] - u[0] * w[2], 2) +
-                                std::pow(u[0] * w[1] - u[1] * w[0], 2));
-    }
-    cumulative[std::size_t(f) + 1] = cumulative[std::size_t(f)] + measure;
-  }
-  const double target = rng.uniform() * cumulative.back();
-  const auto it = std::upper_bound(cumulative.begin(), cumulative.end(), target);
-  const std::int64_t f = std::clamp<std::int64_t>(it - cumulative.begin() - 1, 0, n - 1);
-  const auto v = b.facet(f);
-  std::array<double, 3> x{};
-  if (d == 2) {
-    const double t = rng.uniform();
-    for (int a = 0; a < 2; ++a) x[a] = (1 - t) * b.point(v[0])[a] + t * b.point(v[1])[a];
-  } else {
-    double s = rng.uniform(), t = rng.uniform();
-    if (s + t > 1.0) s = 1.0 - s, t = 1.0 - t;
-    for (int a = 0; a < 3; ++a)
-      x[a] = (1 - s - t) * b.point(v[0])[a] + s * b.point(v[1])[a] + t * b.point(v[2])[a];
-  }
-  return x;
-}
-
 /// Per boundary point: the mean length of its facets' edges through it (the resolved size).
 std::vector<double> boundary_spacing(const geometry::Boundary& b) {
   std::vector<double> sum(std::size_t(b.n_points()), 0.0), count(sum.size(), 0.0);
@@ -137,7 +99,7 @@ geometry::Boundary draw_boundary(const ShapeConfig& c, const std::optional<geome
     geometry::grade_sizes(dense, size, c.size_grading);
     std::vector<double> forced;
     if (c.dirichlet_radius > 0) {
-      out.dirichlet_center = uniform_boundary_point(dense_polygon, patch_rng);
+      out.dirichlet_center = geometry::uniform_boundary_point(dense_polygon, patch_rng);
       // p_D sits on a chord of the dense samples; the exact crossings are on the curve.
       forced = geometry::circle_crossings(phi, dense, {out.dirichlet_center.data(), 2}, c.dirichlet_radius);
     }
@@ -158,7 +120,7 @@ geometry::Boundary draw_boundary(const ShapeConfig& c, const std::optional<geome
   geometry::RemeshOptions remesh;
   remesh.target_edge = h;
   if (c.dirichlet_radius > 0) {
-    out.dirichlet_center = uniform_boundary_point(dense.surface, patch_rng);
+    out.dirichlet_center = geometry::uniform_boundary_point(dense.surface, patch_rng);
     remesh.clamp_center = out.dirichlet_center;
     remesh.clamp_radius = c.dirichlet_radius;
   }

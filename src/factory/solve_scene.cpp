@@ -60,11 +60,7 @@ SceneOutcome solve_scene(MPI_Comm comm, const config::Scene& scene_in) {
   if (!has_dirichlet)
     throw core::InputError(scene.source, "effects",
                            "no Dirichlet condition (e.g. dirichlet_patch): the problem would be singular");
-  for (auto& [k, v] : scene.petsc) {
-    PetscBool set;
-    HS_PETSC(PetscOptionsHasName(nullptr, nullptr, k.c_str(), &set));
-    if (!set) HS_PETSC(PetscOptionsSetValue(nullptr, k.c_str(), v.empty() ? nullptr : v.c_str()));
-  }
+  solver::set_default_options(scene.petsc);
   {
     auto t = o.times.scope("mesh");
     if (scene.base != "file") {

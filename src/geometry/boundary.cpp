@@ -1,5 +1,9 @@
 #include "hypershape/geometry/boundary.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
 namespace hypershape::geometry {
 
 Boundary polygon_boundary(std::vector<double> xy) {
@@ -13,6 +17,46 @@ Boundary polygon_boundary(std::vector<double> xy) {
     b.facets[2 * i + 1] = (i + 1) % n;
   }
   return b;
+}
+
+double facet_measure(const Boundary& b, std::int64_t f) {
+  const auto v = b.facet(f);
+  const auto p = b.point(v[0]), q = b.point(v[1]);
+  if (b.dim == 2) return std::hypot(q[0] - p[0], q[1] - p[1]);
+  const auto r = b.point(v[2]);
+  const double u[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+  const double w[3] = {r[0] - p[0], r[1] - p[1], r[2] - p[2]};
+  return 0.5 * std::sqrt(std::pow(u[1] * w[2] - u[2] * w[1], 2) + std::pow(u[2] * w[0] - u[0] * w[2], 2) +
+                         std::pow(u[0] * w[1] - u[1] * w[0], 2));
+}
+
+std::array<double, 3> uniform_boundary_point(const Boundary& b, core::RandomStream& rng,
+                                             std::span<const std::uint8_t> excluded) {
+  const std::int64_t n = b.n_facets();
+  if (!excluded.empty() && std::int64_t(excluded.size()) != n)
+    throw std::invalid_argument("uniform_boundary_point: mask size != number of facets");
+  std::vector<double> cumulative(std::size_t(n) + 1, 0.0);
+  for (std::int64_t f = 0; f < n; ++f) {
+    const bool skip = !excluded.empty() && excluded[std::size_t(f)];
+    cumulative[std::size_t(f) + 1] = cumulative[std::size_t(f)] + (skip ? 0.0 : facet_measure(b, f));
+  }
+  if (!(cumulative.back() > 0)) throw std::invalid_argument("uniform_boundary_point: no facet to draw from");
+  const double target = rng.uniform() * cumulative.back();
+  const auto it = std::upper_bound(cumulative.begin(), cumulative.end(), target);
+  std::int64_t f = std::clamp<std::int64_t>(it - cumulative.begin() - 1, 0, n - 1);
+  while (cumulative[std::size_t(f) + 1] == cumulative[std::size_t(f)]) --f;  // never an excluded facet
+  const auto v = b.facet(f);
+  std::array<double, 3> x{};
+  if (b.dim == 2) {
+    const double t = rng.uniform();
+    for (int a = 0; a < 2; ++a) x[a] = (1 - t) * b.point(v[0])[a] + t * b.point(v[1])[a];
+  } else {
+    double s = rng.uniform(), t = rng.uniform();
+    if (s + t > 1.0) s = 1.0 - s, t = 1.0 - t;
+    for (int a = 0; a < 3; ++a)
+      x[a] = (1 - s - t) * b.point(v[0])[a] + s * b.point(v[1])[a] + t * b.point(v[2])[a];
+  }
+  return x;
 }
 
 }  // namespace hypershape::geometry

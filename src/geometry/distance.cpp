@@ -617,6 +617,33 @@ void SignedDistance::evaluate(std::span<const double> points, std::span<double> 
   }
 }
 
+int SignedDistance::side(std::span<const double> x) const {
+  assert(x.size() == std::size_t(dim()));
+  return tree_->side(x.data());
+}
+
+namespace {
+ClosestPoint to_closest_point(const detail::ClosestHit& hit) {
+  return {std::sqrt(hit.squared_distance), hit.facet, hit.point};
+}
+}  // namespace
+
+ClosestPoint SignedDistance::closest(std::span<const double> x) const {
+  assert(x.size() == std::size_t(dim()));
+  return to_closest_point(tree_->closest(x.data()));
+}
+
+void SignedDistance::closest(std::span<const double> points, std::span<ClosestPoint> out) const {
+  const std::size_t d = std::size_t(dim());
+  assert(points.size() == out.size() * d);
+  detail::ClosestHit hit;
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const double* x = points.data() + i * d;
+    hit = hit.facet < 0 ? tree_->closest(x) : tree_->closest(x, hit);
+    out[i] = to_closest_point(hit);
+  }
+}
+
 // ---- FacetSetDistance -------------------------------------------------------------------------
 
 FacetSetDistance::FacetSetDistance(const Boundary& boundary, std::span<const std::int64_t> facets) {

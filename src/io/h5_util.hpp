@@ -3,6 +3,8 @@
 #include <hdf5.h>
 
 #include <algorithm>
+#include <map>
+#include <vector>
 #include <stdexcept>
 #include <string>
 
@@ -58,6 +60,61 @@ inline void write_string_dataset(hid_t parent, const char* name, const std::stri
   Id space{check_id(H5Screate(H5S_SCALAR), name), H5Sclose};
   Id ds{check_id(H5Dcreate2(parent, name, type.id, space.id, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), name), H5Dclose};
   check(H5Dwrite(ds.id, type.id, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.empty() ? " " : v.c_str()), name);
+}
+
+
+inline void write_1d(hid_t parent, const char* name, hid_t type, const void* data, hsize_t n) {
+  hsize_t dims[1] = {n};
+  Id space{check_id(H5Screate_simple(1, dims, nullptr), name), H5Sclose};
+  Id ds{check_id(H5Dcreate2(parent, name, type, space.id, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), name), H5Dclose};
+  if (n > 0) check(H5Dwrite(ds.id, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), name);
+}
+
+inline void attr_vector(hid_t obj, const char* name, const std::vector<double>& v) {
+  hsize_t dims[1] = {v.size()};
+  Id space{check_id(H5Screate_simple(1, dims, nullptr), name), H5Sclose};
+  Id a{check_id(H5Acreate2(obj, name, H5T_NATIVE_DOUBLE, space.id, H5P_DEFAULT, H5P_DEFAULT), name), H5Aclose};
+  check(H5Awrite(a.id, H5T_NATIVE_DOUBLE, v.data()), name);
+}
+
+inline Id group(hid_t parent, const std::string& name) {
+  return {check_id(H5Gcreate2(parent, name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), name), H5Gclose};
+}
+
+template <class T>
+inline std::vector<T> read_array(hid_t parent, const char* name, hid_t type, hsize_t* cols = nullptr) {
+  Id ds{check_id(H5Dopen2(parent, name, H5P_DEFAULT), name), H5Dclose};
+  Id sp{check_id(H5Dget_space(ds.id), name), H5Sclose};
+  const int rank = H5Sget_simple_extent_ndims(sp.id);
+  hsize_t dims[2] = {0, 1};
+  H5Sget_simple_extent_dims(sp.id, dims, nullptr);
+  if (cols) *cols = rank == 2 ? dims[1] : 1;
+  std::vector<T> out(dims[0] * (rank == 2 ? dims[1] : 1));
+  if (!out.empty()) check(H5Dread(ds.id, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()), name);
+  return out;
+}
+
+inline std::string read_string(hid_t parent, const char* name) {
+  Id ds{check_id(H5Dopen2(parent, name, H5P_DEFAULT), name), H5Dclose};
+  Id type{check_id(H5Dget_type(ds.id), name), H5Tclose};
+  std::string s(H5Tget_size(type.id), '\0');
+  check(H5Dread(ds.id, type.id, H5S_ALL, H5S_ALL, H5P_DEFAULT, s.data()), name);
+  while (!s.empty() && s.back() == '\0') s.pop_back();
+  return s == " " ? std::string() : s;
+}
+
+inline herr_t collect_double_attr(hid_t obj, const char* name, const H5A_info_t*, void* data) {
+  auto& numbers = *static_cast<std::map<std::string, double>*>(data);
+  Id a{H5Aopen(obj, name, H5P_DEFAULT), H5Aclose};
+  if (a.id < 0) return -1;
+  Id sp{H5Aget_space(a.id), H5Sclose};
+  Id type{H5Aget_type(a.id), H5Tclose};
+  if (H5Tget_class(type.id) == H5T_FLOAT && H5Sget_simple_extent_npoints(sp.id) == 1) {
+    double v = 0.0;
+    if (H5Aread(a.id, H5T_NATIVE_DOUBLE, &v) < 0) return -1;
+    numbers[name] = v;
+  }
+  return 0;
 }
 
 }  // namespace hypershape::io

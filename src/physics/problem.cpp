@@ -76,9 +76,11 @@ Problem::Problem(MPI_Comm comm, const mesh::MeshData& mesh, std::vector<EffectPt
     space_ = std::make_unique<Space>(core::DMH(clone), serial.get(), nullptr, opt, bcs);
   }
   for (auto& e : effects_) e->setup(*space_);
-
-  // Nominal dead load.
   HS_PETSC(DMCreateGlobalVector(dm(), load_.out()));
+  assemble_load();
+}
+
+void Problem::assemble_load() {
   HS_PETSC(VecZeroEntries(load_));
   LocalArray fl(dm(), true);
   for (auto& e : effects_)
@@ -86,6 +88,12 @@ Problem::Problem(MPI_Comm comm, const mesh::MeshData& mesh, std::vector<EffectPt
   fl.release();
   HS_PETSC(DMLocalToGlobal(dm(), fl.vec(), ADD_VALUES, load_));
   HS_PETSC(VecNorm(load_, NORM_2, &load_norm_));
+}
+
+void Problem::reassemble_load() {
+  for (auto& e : effects_)
+    if (e->has_load()) e->setup(*space_);
+  assemble_load();
 }
 
 void Problem::to_local(Vec u, Vec ul) const {

@@ -1,5 +1,7 @@
 #include "hypershape/solver/nonlinear.hpp"
 
+#include "hypershape/core/timer.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -24,6 +26,14 @@ PetscErrorCode guarded(F&& f) {
 }
 
 }  // namespace
+
+void set_default_options(const std::vector<std::pair<std::string, std::string>>& options) {
+  for (const auto& [k, v] : options) {
+    PetscBool set;
+    HS_PETSC(PetscOptionsHasName(nullptr, nullptr, k.c_str(), &set));
+    if (!set) HS_PETSC(PetscOptionsSetValue(nullptr, k.c_str(), v.empty() ? nullptr : v.c_str()));
+  }
+}
 
 NonlinearSolver::NonlinearSolver(const physics::Problem& problem, const SolverOptions& opt,
                                  const std::string& prefix)
@@ -238,8 +248,17 @@ double NonlinearSolver::linear_response() {
 }
 
 TargetResult NonlinearSolver::solve_for_target(double target) {
+  const double start = core::now_seconds();
+  TargetResult t = search_target(target, start);
+  t.seconds_total = core::now_seconds() - start;
+  if (t.solves <= 1) t.seconds_first_solve = t.seconds_total;
+  return t;
+}
+
+TargetResult NonlinearSolver::search_target(double target, double start) {
   TargetResult t;
   auto account = [&](const SolveResult& r) {
+    if (t.solves == 0) t.seconds_first_solve = core::now_seconds() - start;
     ++t.solves;
     t.newton_iterations += r.newton_iterations;
     t.failed_increments += r.failed_increments;

@@ -1,9 +1,12 @@
 #pragma once
-/// A dataset config: which shapes (and, later, which load cases) a dataset holds.
+/// A dataset config: which shapes, which load cases per shape, what is solved and what is
+/// stored. The paper's datasets are presets (configs/presets/*.yaml, embedded in the binary);
+/// a config may start from one with `preset: NAME` and override any key.
 ///
 /// ```yaml
+/// preset: random2d                # optional: start from configs/presets/random2d.yaml
 /// name: random2d
-/// seed: 1001                      # every random draw is a function of (seed, shape id, ...)
+/// seed: 1001                      # every random draw is a function of (seed, shape id, load id)
 /// shapes:
 ///   count: 1000
 ///   dim: 2                        # 2 | 3
@@ -17,28 +20,86 @@
 ///   min_feature_fraction: 0.1     # optional: redraw shapes with necks thinner than this * h
 ///   max_attempts: 20              # optional
 ///   quality: {min_angle_deg: 18, min_shape: 0.3}   # optional mesh gate
+/// loads:                          # optional block; these are the defaults
+///   count: 50                     # load cases per shape
+///   gamma: 0.2                    # traction width (paper: 0.2 in 2D, 0.1 in 3D)
+///   target: [0.1, 0.5]            # max|u| range, covered by stratified sampling
+/// material: {E: 500, nu: 0.49}    # compressible Neo-Hookean (appendix A)
+/// mesh: {degree: 1}               # P1 | P2
+/// representations:
+///   point_cloud: true             # SDF, Dirichlet distance and traction at the mesh nodes
+///   grid: true                    # SDF, Dirichlet distance, traction, displacement on a grid
+///   grid_size: 128                # points per axis over [-1, 1]^d (default 128 2D, 64 3D)
+/// split: {train: 0.8, val: 0.1, test: 0.1}   # by shape, deterministic
+/// output: {shard_size: 8}         # shapes per HDF5 shard (the unit of work and of resume)
+/// solver: {rtol: 1e-9, max_newton: 12, max_increments: 64, target_rtol: 1e-3}
+/// petsc: {snes_monitor: ""}       # any PETSc option; the command line wins
 /// ```
 /// Every key is checked; errors name the file and the key path (core::InputError).
 #include <cstdint>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "hypershape/factory/shape_pipeline.hpp"
+#include "hypershape/solver/nonlinear.hpp"
 
 namespace hypershape::config {
 
+struct LoadsConfig {
+  int count = 50;             ///< load cases per shape
+  double gamma = 0.2;         ///< width of the Gaussian traction
+  double target_min = 0.1;    ///< range of the target max|u|
+  double target_max = 0.5;
+};
+
+struct MaterialConfig {
+  double E = 500.0;
+  double nu = 0.49;
+};
+
+struct RepresentationsConfig {
+  bool point_cloud = true;
+  bool grid = true;
+  int grid_size = 0;          ///< points per axis; 0 until resolved (128 in 2D, 64 in 3D)
+};
+
+struct SplitConfig {
+  double train = 0.8, val = 0.1, test = 0.1;
+};
+
 struct DatasetConfig {
-  std::string source;  ///< file name
-  std::string text;    ///< the YAML as read (stored with the data)
+  std::string source;     ///< file name, or "<default dataset>"
+  std::string text;       ///< the resolved YAML (preset merged), stored with the data
+  std::string preset;     ///< the preset it started from, if any
   std::string name;
   std::uint64_t seed = 0;
   std::int64_t n_shapes = 0;
   factory::ShapeConfig shapes;
+  LoadsConfig loads;
+  MaterialConfig material;
+  int degree = 1;
+  RepresentationsConfig representations;
+  SplitConfig split;
+  int shard_size = 8;
+  solver::SolverOptions solver;
+  std::vector<std::pair<std::string, std::string>> petsc;  ///< option (with dash), value
 };
+
+/// A dataset preset embedded from configs/presets/NAME.yaml at build time.
+struct Preset {
+  const char* name;
+  const char* directory;  ///< where the file lived (relative paths in it resolve there)
+  const char* text;
+};
+const std::vector<Preset>& presets();
 
 /// Parses and validates a dataset config; relative paths (base_file) are resolved against the
 /// file's directory. Throws core::InputError.
 DatasetConfig parse_dataset_file(const std::string& path);
 DatasetConfig parse_dataset_text(const std::string& text, const std::string& source,
                                  const std::string& base_dir = ".");
+/// The embedded default dataset: a small Random2D slice (a minute on a laptop).
+const char* default_dataset_text();
 
 }  // namespace hypershape::config

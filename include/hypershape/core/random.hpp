@@ -23,6 +23,7 @@ enum class Purpose : std::uint64_t {
   dirichlet = 2,   ///< Dirichlet patch centre p_D
   traction = 3,    ///< traction centre p_N and direction g
   target = 4,      ///< target displacement magnitude of a load case
+  split = 5,       ///< train/val/test assignment of shapes
   test = 99,       ///< tests and benchmarks
 };
 

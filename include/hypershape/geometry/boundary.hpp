@@ -6,6 +6,8 @@
 #include <span>
 #include <vector>
 
+#include "hypershape/core/random.hpp"
+
 namespace hypershape::geometry {
 
 /// A closed boundary.
@@ -32,5 +34,14 @@ struct Boundary {
 
 /// A closed polygon through `xy` (n * 2 coordinates, counter-clockwise) as a Boundary.
 Boundary polygon_boundary(std::vector<double> xy);
+
+/// Length (2D) or area (3D) of facet f.
+double facet_measure(const Boundary& b, std::int64_t f);
+
+/// A point drawn uniformly by length / area on the facets of `b`, skipping the facets with
+/// `excluded[f] != 0` (none when empty). Draws 2 (2D) or 3 (3D) uniforms from `rng`.
+/// Throws std::invalid_argument if no facet is left.
+std::array<double, 3> uniform_boundary_point(const Boundary& b, core::RandomStream& rng,
+                                             std::span<const std::uint8_t> excluded = {});
 
 }  // namespace hypershape::geometry

@@ -2,7 +2,9 @@
 /// Distances to a Boundary: signed distance to the whole boundary, unsigned distance to a
 /// subset of its facets. Both build a bounding-volume hierarchy once and answer point queries in
 /// about O(log n_facets); CGAL (exact predicates, Epick kernel) stays inside the .cpp.
+#include <array>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <span>
 
@@ -13,6 +15,13 @@ namespace hypershape::geometry {
 namespace detail {
 class FacetTree;
 }
+
+/// The closest point of a boundary to a query point.
+struct ClosestPoint {
+  double distance = std::numeric_limits<double>::infinity();  ///< unsigned, >= 0
+  std::int64_t facet = -1;        ///< index of the facet it lies on (into Boundary::facets)
+  std::array<double, 3> point{};  ///< its coordinates (third entry 0 in 2D)
+};
 
 /// Signed distance to a closed boundary (2D polygon or 3D triangle surface): negative inside,
 /// positive outside, 0 on the boundary.
@@ -43,6 +52,17 @@ class SignedDistance {
   /// Batched: `points` holds n * dim coordinates, `out` n values. Faster than n calls for
   /// spatially coherent points (each query starts from the previous answer).
   void evaluate(std::span<const double> points, std::span<double> out) const;
+
+  /// Exact location of x (`dim` coordinates): -1 inside, 0 on the boundary, +1 outside; the
+  /// sign of operator() without the distance.
+  int side(std::span<const double> x) const;
+  /// Closest point of the boundary to x (`dim` coordinates). When several facets are equally
+  /// close (x on the medial axis, or the closest point a shared vertex or edge), one of them.
+  /// Degenerate facets (zero length / area) are never returned.
+  ClosestPoint closest(std::span<const double> x) const;
+  /// Batched: `points` holds n * dim coordinates, `out` n results. Faster than n calls for
+  /// spatially coherent points (each query starts from the previous answer).
+  void closest(std::span<const double> points, std::span<ClosestPoint> out) const;
 
  private:
   std::unique_ptr<detail::FacetTree> tree_;

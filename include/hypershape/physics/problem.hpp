@@ -33,6 +33,9 @@ class Problem {
   /// The nominal external load f_ext (global vector).
   Vec load() const { return load_.get(); }
   double load_norm() const { return load_norm_; }
+  /// Re-runs the set-up of the load effects and reassembles f_ext, after a load effect was
+  /// changed (e.g. GaussianTraction::set for the next load case). Collective.
+  void reassemble_load();
 
   /// Each returns false (on every rank) if u has det F <= 0 at some quadrature point. Collective.
   bool energy(Vec u, double load_factor, double& value) const;
@@ -56,6 +59,7 @@ class Problem {
  private:
   /// Global -> local with the essential values inserted.
   void to_local(Vec u, Vec ul) const;
+  void assemble_load();
   std::vector<EffectPtr> effects_;
   std::unique_ptr<Space> space_;
   core::VecH load_;

@@ -16,6 +16,8 @@
 #include <petscsnes.h>
 
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "hypershape/core/petsc_handle.hpp"
 #include "hypershape/physics/problem.hpp"
@@ -54,7 +56,13 @@ struct TargetResult {
   int solves = 0;              ///< nonlinear solves (alpha evaluations)
   int newton_iterations = 0;
   int failed_increments = 0;
+  double seconds_first_solve = 0;  ///< linear response + the first nonlinear solve
+  double seconds_total = 0;
 };
+
+/// Puts config-file PETSc options (name with dash, value or "") into the options database,
+/// except those already given (on the command line, which wins). Not collective.
+void set_default_options(const std::vector<std::pair<std::string, std::string>>& options);
 
 class NonlinearSolver {
  public:
@@ -88,6 +96,7 @@ class NonlinearSolver {
   static PetscErrorCode guarded_line_search(SNESLineSearch, void*);
   void line_search(SNESLineSearch ls);
   bool newton(double s, SolveResult& r);
+  TargetResult search_target(double target, double start);
 
   const physics::Problem& problem_;
   SolverOptions opt_;

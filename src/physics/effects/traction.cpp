@@ -3,8 +3,10 @@
 /// I_N = int_{Gamma_N} phi dS by the facet rule. alpha is the problem's load factor.
 /// Keys: center (p_N), direction (g, normalised here), gamma (> 0).
 #include <cmath>
+#include <stdexcept>
 
 #include "hypershape/core/error.hpp"
+#include "hypershape/physics/gaussian_traction.hpp"
 #include "hypershape/physics/registry.hpp"
 
 namespace hypershape::physics {
@@ -58,58 +60,70 @@ class SurfaceTraction : public Effect {
   FacetPredicate select_;
 };
 
-class GaussianTraction : public SurfaceTraction {
- public:
-  GaussianTraction(std::vector<double> center, std::vector<double> g, double gamma)
-      : SurfaceTraction("gaussian_traction", {}, {}),
-        center_(std::move(center)),
-        g_(std::move(g)),
-        gamma_(gamma) {}
-
-  void setup(const Space& s) override {
-    double integral = 0;
-    for_each_facet_point(s, {}, [&](const FacetView&, const double*, const double* x, double w) {
-      integral += w * phi(x, s.dim());
-    });
-    MPI_Allreduce(MPI_IN_PLACE, &integral, 1, MPI_DOUBLE, MPI_SUM, s.comm());
-    if (!(integral > 0))
-      throw core::InputError("", "gaussian_traction",
-                             "the Neumann boundary is empty or far from the traction centre "
-                             "(int phi = 0)");
-    normaliser_ = integral;
-    const int dim = s.dim();
-    traction_ = [this, dim](const double* x, double* t) {
-      const double v = phi(x, dim) / normaliser_;
-      for (int i = 0; i < dim; ++i) t[i] = g_[i] * v;
-    };
-  }
-  double normaliser() const { return normaliser_; }
-
- private:
-  double phi(const double* x, int dim) const {
-    double r2 = 0;
-    for (int k = 0; k < dim; ++k) r2 += (x[k] - center_[k]) * (x[k] - center_[k]);
-    return std::exp(-r2 / (2.0 * gamma_ * gamma_));
-  }
-  std::vector<double> center_, g_;
-  double gamma_;
-  double normaliser_ = 0;
-};
-
 }  // namespace
 
 EffectPtr make_surface_traction(VectorFunction traction, FacetPredicate select) {
   return std::make_unique<SurfaceTraction>("surface_traction", std::move(traction), std::move(select));
 }
 
-EffectPtr make_gaussian_traction(const std::vector<double>& center,
-                                 const std::vector<double>& direction, double gamma) {
+GaussianTraction::GaussianTraction(std::vector<double> center, std::vector<double> direction,
+                                   double gamma)
+    : gamma_(gamma) {
+  set(std::move(center), std::move(direction));
+}
+
+void GaussianTraction::set(std::vector<double> center, std::vector<double> direction) {
   double n = 0;
   for (double v : direction) n += v * v;
   n = std::sqrt(n);
-  std::vector<double> g(direction);
-  for (double& v : g) v /= n;
-  return std::make_unique<GaussianTraction>(center, g, gamma);
+  if (!(n > 0) || center.size() != direction.size())
+    throw std::invalid_argument("GaussianTraction: direction must be non-zero, of the centre's size");
+  for (double& v : direction) v /= n;
+  center_ = std::move(center);
+  g_ = std::move(direction);
+  normaliser_ = 0;
+}
+
+double GaussianTraction::phi(const double* x) const {
+  double r2 = 0;
+  for (int k = 0; k < dim_; ++k) r2 += (x[k] - center_[k]) * (x[k] - center_[k]);
+  return std::exp(-r2 / (2.0 * gamma_ * gamma_));
+}
+
+void GaussianTraction::setup(const Space& s) {
+  dim_ = s.dim();
+  double integral = 0;
+  for_each_facet_point(s, {}, [&](const FacetView&, const double*, const double* x, double w) {
+    integral += w * phi(x);
+  });
+  MPI_Allreduce(MPI_IN_PLACE, &integral, 1, MPI_DOUBLE, MPI_SUM, s.comm());
+  if (!(integral > 0))
+    throw core::InputError("", "gaussian_traction",
+                           "the Neumann boundary is empty or far from the traction centre "
+                           "(int phi = 0)");
+  normaliser_ = integral;
+}
+
+void GaussianTraction::value(const double* x, double* t) const {
+  const double v = phi(x) / normaliser_;
+  for (int i = 0; i < dim_; ++i) t[i] = g_[i] * v;
+}
+
+void GaussianTraction::add_load(const Space& s, PetscScalar* f) const {
+  const int dim = s.dim();
+  for_each_facet_point(s, {}, [&](const FacetView& fv, const double* bary, const double* x, double w) {
+    double t[3] = {0, 0, 0};
+    value(x, t);
+    for (int n = 0; n < fv.n_nodes; ++n) {
+      const double wn = w * s.facet_basis(fv.ends[n], bary);
+      for (int i = 0; i < dim; ++i) f[fv.offset[n] + i] += wn * t[i];
+    }
+  });
+}
+
+EffectPtr make_gaussian_traction(const std::vector<double>& center,
+                                 const std::vector<double>& direction, double gamma) {
+  return std::make_unique<GaussianTraction>(center, direction, gamma);
 }
 
 void register_gaussian_traction() {

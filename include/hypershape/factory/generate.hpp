@@ -1,0 +1,56 @@
+#pragma once
+/// `hypershape generate`: a dataset from a config, on any number of ranks and SLURM tasks.
+///
+/// Plan: shapes [0, N) in shards of `shard_size` consecutive shapes; shard k belongs to SLURM
+/// task k mod task_count. Schedule: the ranks split into solver groups of `group_size`; groups
+/// take the task's unfinished shards one at a time from a shared counter (MPI one-sided
+/// fetch-and-add on rank 0), so a hard shape holds up only its own group. Every value stored is
+/// a function of (seed, shape id, load id): the dataset does not depend on ranks, groups or
+/// tasks. A shard is written under a temporary name and renamed when complete; a rerun skips
+/// complete shards and redoes the rest (resume after a kill).
+///
+/// Output directory:
+///   dataset.yaml                     the resolved config (a rerun with another config stops)
+///   shards/shard-NNNNNN.h5           the data (docs/FORMAT.md)
+///   reports/task-I-of-N.json         run report per task: counts, phases, memory
+///   manifest.json, splits.json, stats.json   written by the index step (dataset_index.hpp),
+///   xdmf/shard-NNNNNN.xdmf           run automatically once every shard exists
+#include <mpi.h>
+
+#include <cstdint>
+#include <map>
+#include <string>
+
+#include "hypershape/config/dataset.hpp"
+
+namespace hypershape::factory {
+
+struct GenerateOptions {
+  std::string output_dir;
+  int task_index = 0, task_count = 1;  ///< SLURM array slice
+  int group_size = 1;                  ///< ranks per shape
+  double progress_seconds = 10;        ///< interval of the progress line (0: none)
+};
+
+struct RunReport {
+  std::int64_t shards_total = 0, shards_done_before = 0, shards_written = 0;
+  std::int64_t shapes = 0, shapes_failed = 0, loads_ok = 0, loads_failed = 0;
+  std::int64_t newton_iterations = 0, solves = 0, failed_increments = 0;
+  double seconds = 0;
+  std::map<std::string, double> phase_seconds;  ///< summed over group roots
+  double factorization_seconds = 0;             ///< PCSetUp, summed over ranks
+  std::string json;                              ///< the report as written (rank 0)
+  bool indexed = false;                          ///< manifest written (dataset complete)
+};
+
+/// Collective over `comm`. Throws core::InputError (before any work) for an unusable output
+/// directory or one that holds another dataset.
+RunReport generate(MPI_Comm comm, const config::DatasetConfig& config, const GenerateOptions& options);
+
+/// The report as a short table (rank 0).
+std::string report_table(const RunReport& report);
+
+/// Shard file name of shard k.
+std::string shard_name(std::int64_t k);
+
+}  // namespace hypershape::factory

@@ -1,0 +1,28 @@
+#include "solver_block.hpp"
+
+namespace hypershape::config {
+
+void parse_solver_block(const YamlBlock& sol, solver::SolverOptions& s) {
+  if (sol.has("rtol")) s.rtol = sol.number("rtol");
+  if (!(s.rtol > 0 && s.rtol < 1)) sol.fail("rtol", "must be in (0, 1)");
+  if (sol.has("max_newton")) s.max_newton = int(sol.integer("max_newton"));
+  if (s.max_newton < 1) sol.fail("max_newton", "must be >= 1");
+  if (sol.has("max_increments")) s.max_increments = int(sol.integer("max_increments"));
+  if (s.max_increments < 1) sol.fail("max_increments", "must be >= 1");
+  if (sol.has("target_rtol")) s.target_rtol = sol.number("target_rtol");
+  if (!(s.target_rtol > 0 && s.target_rtol < 1)) sol.fail("target_rtol", "must be in (0, 1)");
+  sol.allowed("rtol, max_newton, max_increments, target_rtol");
+  sol.check_all_used();
+}
+
+void parse_petsc_block(const YamlBlock& petsc, std::vector<std::pair<std::string, std::string>>& out) {
+  if (!petsc.node() || !petsc.node().IsMap()) return;
+  for (const auto& kv : petsc.node()) {
+    const std::string k = kv.first.Scalar();
+    petsc.get(k);
+    if (!kv.second.IsNull() && !kv.second.IsScalar()) petsc.fail(k, "must be a scalar value");
+    out.emplace_back("-" + k, kv.second.IsNull() ? "" : kv.second.Scalar());
+  }
+}
+
+}  // namespace hypershape::config

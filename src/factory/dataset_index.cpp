@@ -1,0 +1,180 @@
+#include "hypershape/factory/dataset_index.hpp"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <numeric>
+#include <sstream>
+
+#include "hypershape/config/dataset.hpp"
+#include "hypershape/core/input_error.hpp"
+#include "hypershape/core/random.hpp"
+#include "hypershape/factory/generate.hpp"
+#include "hypershape/io/dataset_shard.hpp"
+#include "hypershape/io/dataset_xdmf.hpp"
+
+namespace hypershape::factory {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+void write_json(const fs::path& path, const json& j) {
+  const fs::path tmp = path.string() + fmt::format(".tmp-{}", ::getpid());
+  {
+    std::ofstream o(tmp);
+    o << j.dump(1) << "\n";
+    if (!o) throw std::runtime_error("cannot write " + tmp.string());
+  }
+  fs::rename(tmp, path);
+}
+
+/// Shape ids [0, n) cut into train / val / test by a seeded permutation.
+std::map<std::string, std::vector<std::int64_t>> make_splits(const config::DatasetConfig& c) {
+  const std::int64_t n = c.n_shapes;
+  std::vector<std::int64_t> ids(static_cast<std::size_t>(n));
+  std::iota(ids.begin(), ids.end(), 0);
+  core::RandomStream rng(c.seed, core::Purpose::split, {});
+  for (std::int64_t i = n - 1; i > 0; --i) {
+    const auto j = std::min<std::int64_t>(i, std::int64_t(rng.uniform() * double(i + 1)));
+    std::swap(ids[std::size_t(i)], ids[std::size_t(j)]);
+  }
+  const auto n_train = std::int64_t(std::llround(c.split.train * double(n)));
+  const auto n_val = std::min<std::int64_t>(n - n_train, std::llround(c.split.val * double(n)));
+  std::map<std::string, std::vector<std::int64_t>> out;
+  out["train"].assign(ids.begin(), ids.begin() + n_train);
+  out["val"].assign(ids.begin() + n_train, ids.begin() + n_train + n_val);
+  out["test"].assign(ids.begin() + n_train + n_val, ids.end());
+  for (auto& [k, v] : out) std::sort(v.begin(), v.end());
+  return out;
+}
+
+}  // namespace
+
+IndexReport index_dataset(const std::string& dir) {
+  const fs::path root(dir);
+  const fs::path yaml = root / "dataset.yaml";
+  if (!fs::exists(yaml)) throw core::InputError(dir, "", "not a dataset directory (no dataset.yaml)");
+  const config::DatasetConfig cfg = config::parse_dataset_file(yaml.string());
+  // The shards carry the digest of the text generate wrote to dataset.yaml.
+  std::string text;
+  {
+    std::ifstream in(yaml);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    text = ss.str();
+  }
+  const std::string hash = io::text_digest(text);
+  IndexReport rep;
+  rep.shards = (cfg.n_shapes + cfg.shard_size - 1) / cfg.shard_size;
+
+  json shards = json::array();
+  std::vector<std::int64_t> failed_shapes;
+  std::map<std::int64_t, const io::ShardSummary::Shape*> by_id;
+  std::vector<io::ShardSummary> summaries;
+  summaries.reserve(std::size_t(rep.shards));
+  for (std::int64_t k = 0; k < rep.shards; ++k) {
+    const fs::path p = root / "shards" / shard_name(k);
+    if (!fs::exists(p)) {
+      rep.missing_shards.push_back(k);
+      continue;
+    }
+    summaries.push_back(io::read_shard_summary(p.string()));
+    const auto& s = summaries.back();
+    if (s.header.config_hash != hash || s.header.shard_index != k)
+      throw std::runtime_error(p.string() + ": belongs to another dataset or shard");
+    std::int64_t ok = 0, failed = 0, lok = 0, lfailed = 0;
+    for (const auto& sh : s.shapes) {
+      (sh.ok ? ok : failed) += 1;
+      lok += sh.loads_ok;
+      lfailed += sh.loads_failed;
+      if (!sh.ok) failed_shapes.push_back(sh.shape_id);
+    }
+    rep.shapes_ok += ok;
+    rep.shapes_failed += failed;
+    rep.loads_ok += lok;
+    rep.loads_failed += lfailed;
+    shards.push_back({{"file", "shards/" + shard_name(k)},
+                      {"index", k},
+                      {"first_shape", s.header.first_shape},
+                      {"n_shapes", s.header.n_shapes},
+                      {"shapes_ok", ok},
+                      {"shapes_failed", failed},
+                      {"load_cases_converged", lok},
+                      {"load_cases_failed", lfailed},
+                      {"bytes", std::int64_t(fs::file_size(p))},
+                      {"crc32", fmt::format("{:08x}", io::file_crc32(p.string()))}});
+  }
+  for (const auto& s : summaries)
+    for (const auto& sh : s.shapes) by_id[sh.shape_id] = &sh;
+
+  json manifest = {{"format", "hypershape-dataset"},
+                   {"format_version", io::dataset_format_version},
+                   {"name", cfg.name},
+                   {"config_hash", hash},
+                   {"dim", cfg.shapes.dim},
+                   {"n_shapes", cfg.n_shapes},
+                   {"load_cases_per_shape", cfg.loads.count},
+                   {"shard_size", cfg.shard_size},
+                   {"complete", rep.complete()},
+                   {"missing_shards", rep.missing_shards},
+                   {"failed_shapes", failed_shapes},
+                   {"totals",
+                    {{"shapes_ok", rep.shapes_ok},
+                     {"shapes_failed", rep.shapes_failed},
+                     {"load_cases_converged", rep.loads_ok},
+                     {"load_cases_failed", rep.loads_failed}}},
+                   {"shards", shards}};
+  write_json(root / "manifest.json", manifest);
+  if (!rep.complete()) return rep;
+
+  // Splits by shape; failed shapes are in no split.
+  auto splits = make_splits(cfg);
+  json js = {{"seed", cfg.seed},
+             {"fractions", {{"train", cfg.split.train}, {"val", cfg.split.val}, {"test", cfg.split.test}}}};
+  for (auto& [name, ids] : splits) {
+    std::vector<std::int64_t> kept;
+    for (auto id : ids)
+      if (by_id.count(id) && by_id[id]->ok) kept.push_back(id);
+    js[name] = kept;
+    ids = kept;
+  }
+  write_json(root / "splits.json", js);
+
+  // Normalisation statistics over the train split (fixed order: shape id).
+  std::map<std::string, std::vector<double>> sums;
+  for (auto id : splits["train"])
+    for (const auto& [field, rows] : by_id[id]->stats) {
+      auto& acc = sums[field];
+      acc.resize(rows.size(), 0.0);
+      for (std::size_t i = 0; i < rows.size(); ++i) acc[i] += rows[i];
+    }
+  json stats = json::object();
+  for (const auto& [field, acc] : sums) {
+    std::vector<double> mean, stdev, rms, count;
+    for (std::size_t c = 0; c + 2 < acc.size(); c += 3) {
+      const double n = acc[c], m = n > 0 ? acc[c + 1] / n : 0, q = n > 0 ? acc[c + 2] / n : 0;
+      count.push_back(n);
+      mean.push_back(m);
+      stdev.push_back(std::sqrt(std::max(0.0, q - m * m)));
+      rms.push_back(std::sqrt(std::max(0.0, q)));
+    }
+    stats[field] = {{"count", count}, {"mean", mean}, {"std", stdev}, {"rms", rms}};
+  }
+  write_json(root / "stats.json", {{"split", "train"}, {"n_shapes", splits["train"].size()}, {"fields", stats}});
+
+  fs::create_directories(root / "xdmf");
+  for (std::int64_t k = 0; k < rep.shards; ++k)
+    io::write_dataset_xdmf((root / "shards" / shard_name(k)).string(),
+                           (root / "xdmf" / fmt::format("shard-{:06d}.xdmf", k)).string());
+  return rep;
+}
+
+}  // namespace hypershape::factory

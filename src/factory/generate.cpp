@@ -1,0 +1,370 @@
+#include "hypershape/factory/generate.hpp"
+
+#include <fmt/format.h>
+#include <gmsh.h>
+#include <nlohmann/json.hpp>
+#include <petscsys.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "hypershape/core/collective.hpp"
+#include "hypershape/core/error.hpp"
+#include "hypershape/core/log.hpp"
+#include "hypershape/core/timer.hpp"
+#include "hypershape/factory/dataset_index.hpp"
+#include "hypershape/factory/shape_job.hpp"
+#include "hypershape/factory/shape_pipeline.hpp"
+#include "hypershape/io/dataset_shard.hpp"
+#include "hypershape/solver/nonlinear.hpp"
+
+namespace hypershape::factory {
+
+namespace fs = std::filesystem;
+
+std::string shard_name(std::int64_t k) { return fmt::format("shard-{:06d}.h5", k); }
+
+namespace {
+
+/// Counters on rank 0, updated by one-sided atomics from the group roots.
+enum Counter { next_shard = 0, shapes_done, loads_ok, loads_failed, shapes_failed, n_counters };
+
+class SharedCounters {
+ public:
+  explicit SharedCounters(MPI_Comm comm) {
+    MPI_Comm_rank(comm, &rank_);
+    const MPI_Aint bytes = rank_ == 0 ? MPI_Aint(n_counters * sizeof(std::int64_t)) : 0;
+    MPI_Win_allocate(bytes, sizeof(std::int64_t), MPI_INFO_NULL, comm, &base_, &win_);
+    if (rank_ == 0) {
+      MPI_Win_lock(MPI_LOCK_EXCLUSIVE, 0, 0, win_);
+      for (int i = 0; i < n_counters; ++i) base_[i] = 0;
+      MPI_Win_unlock(0, win_);
+    }
+    MPI_Barrier(comm);
+  }
+  ~SharedCounters() { MPI_Win_free(&win_); }
+  std::int64_t fetch_add(Counter c, std::int64_t v) {
+    std::int64_t old = 0;
+    MPI_Win_lock(MPI_LOCK_SHARED, 0, 0, win_);
+    MPI_Fetch_and_op(&v, &old, MPI_INT64_T, 0, MPI_Aint(c), MPI_SUM, win_);
+    MPI_Win_unlock(0, win_);
+    return old;
+  }
+  std::array<std::int64_t, n_counters> read() {
+    std::array<std::int64_t, n_counters> out{};
+    for (int i = 0; i < n_counters; ++i) out[std::size_t(i)] = fetch_add(Counter(i), 0);
+    return out;
+  }
+
+ private:
+  int rank_ = 0;
+  std::int64_t* base_ = nullptr;
+  MPI_Win win_;
+};
+
+double peak_rss_mib() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return double(u.ru_maxrss) / 1024.0;
+}
+
+void write_atomically(const fs::path& path, const std::string& text) {
+  const fs::path tmp = path.string() + fmt::format(".tmp-{}", ::getpid());
+  {
+    std::ofstream o(tmp);
+    o << text;
+    if (!o) throw std::runtime_error("cannot write " + tmp.string());
+  }
+  fs::rename(tmp, path);
+}
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::map<std::string, std::string> software_versions() {
+  char petsc[256];
+  PetscGetVersion(petsc, sizeof petsc);
+  std::string gmsh_version;
+  gmsh::option::getString("General.Version", gmsh_version);
+  return {{"petsc", petsc}, {"gmsh", gmsh_version}};
+}
+
+/// Output checks and the shards this task still has to write (rank 0; throws InputError).
+std::vector<std::int64_t> prepare_output(const config::DatasetConfig& cfg, const GenerateOptions& opt,
+                                         std::int64_t n_shards, std::int64_t& done_before) {
+  const fs::path out(opt.output_dir);
+  const std::string key = "-o";
+  std::error_code ec;
+  if (fs::exists(out, ec) && !fs::is_directory(out, ec))
+    throw core::InputError("", key, "output exists and is not a directory: " + out.string());
+  const fs::path yaml = out / "dataset.yaml";
+  if (fs::exists(yaml)) {
+    if (read_text(yaml) != cfg.text)
+      throw core::InputError("", key,
+                             out.string() + " holds another dataset (its dataset.yaml differs from this "
+                             "config); use another output directory");
+  }
+  fs::create_directories(out / "shards", ec);
+  if (ec || access(out.c_str(), W_OK) != 0 || access((out / "shards").c_str(), W_OK) != 0)
+    throw core::InputError("", key, "cannot create or write the output directory " + out.string() +
+                                        (ec ? ": " + ec.message() : ""));
+  fs::create_directories(out / "reports", ec);
+  if (!fs::exists(yaml)) write_atomically(yaml, cfg.text);
+
+  const std::string hash = io::text_digest(cfg.text);
+  std::vector<std::int64_t> todo;
+  for (std::int64_t k = opt.task_index; k < n_shards; k += opt.task_count) {
+    const fs::path p = out / "shards" / shard_name(k);
+    fs::remove(p.string() + ".tmp", ec);  // a kill left it: this task owns shard k
+    if (io::is_complete_shard(p.string(), hash)) {
+      ++done_before;
+      continue;
+    }
+    fs::remove(p, ec);  // damaged (should not happen: shards appear by rename)
+    todo.push_back(k);
+  }
+  return todo;
+}
+
+std::string format_duration(double s) {
+  if (!std::isfinite(s) || s < 0) return "?";
+  const long t = long(s + 0.5);
+  return t >= 3600 ? fmt::format("{}h{:02d}m", t / 3600, (t % 3600) / 60)
+                   : fmt::format("{}m{:02d}s", t / 60, t % 60);
+}
+
+}  // namespace
+
+RunReport generate(MPI_Comm comm, const config::DatasetConfig& cfg, const GenerateOptions& opt) {
+  const double start = core::now_seconds();
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  if (opt.task_count < 1 || opt.task_index < 0 || opt.task_index >= opt.task_count)
+    throw core::InputError("", "--task-index", fmt::format("must be in [0, {}) (--task-count)", opt.task_count));
+  if (opt.group_size < 1 || opt.group_size > size)
+    throw core::InputError("", "--group-size", fmt::format("must be in [1, {}] (the number of ranks)", size));
+
+  RunReport rep;
+  const std::int64_t S = cfg.shard_size;
+  rep.shards_total = (cfg.n_shapes + S - 1) / S;
+  std::vector<std::int64_t> todo;
+  std::int64_t done_before = 0;
+  core::on_root(comm, [&] { todo = prepare_output(cfg, opt, rep.shards_total, done_before); });
+  {
+    std::int64_t n = std::int64_t(todo.size());
+    MPI_Bcast(&n, 1, MPI_INT64_T, 0, comm);
+    todo.resize(std::size_t(n));
+    MPI_Bcast(todo.data(), int(n), MPI_INT64_T, 0, comm);
+    MPI_Bcast(&done_before, 1, MPI_INT64_T, 0, comm);
+  }
+  rep.shards_done_before = done_before;
+  const std::optional<geometry::Boundary> base = load_base(cfg.shapes);
+  solver::set_default_options(cfg.petsc);
+  HS_PETSC(PetscLogDefaultBegin());
+
+  std::int64_t todo_shapes = 0;
+  for (auto k : todo) todo_shapes += std::min<std::int64_t>(S, cfg.n_shapes - k * S);
+  const std::int64_t todo_loads = todo_shapes * cfg.loads.count;
+  core::info(comm, "[generate] {}: {} shapes x {} load cases, {} shards ({} done before, {} to do by task {}/{}), "
+             "{} ranks in groups of {} -> {}",
+             cfg.name, cfg.n_shapes, cfg.loads.count, rep.shards_total, done_before, todo.size(),
+             opt.task_index, opt.task_count, size, opt.group_size, opt.output_dir);
+
+  MPI_Comm group;
+  MPI_Comm_split(comm, rank / opt.group_size, rank, &group);
+  int grank = 0;
+  MPI_Comm_rank(group, &grank);
+  const bool group_root = grank == 0;
+  const std::string hash = io::text_digest(cfg.text);
+  const auto software = software_versions();
+
+  core::PhaseTimes times;
+  ShapeJobResult totals;  // counters only
+  std::int64_t shards_written = 0;
+  double last_print = core::now_seconds();
+  auto print_progress = [&](SharedCounters& c, bool force) {
+    if (rank != 0 || opt.progress_seconds <= 0) return;
+    const double now = core::now_seconds();
+    if (!force && now - last_print < opt.progress_seconds) return;
+    last_print = now;
+    const auto v = c.read();
+    const std::int64_t loads = v[loads_ok] + v[loads_failed];
+    const double rate = loads / std::max(1e-9, now - start);
+    core::info(comm, "[generate] {}/{} shapes, {}/{} load cases ({} failed, {} shapes failed), {:.2f} load cases/s, "
+               "elapsed {}, ETA {}", v[shapes_done], todo_shapes, loads, todo_loads, v[loads_failed],
+               v[shapes_failed], rate, format_duration(now - start),
+               format_duration(rate > 0 ? (todo_loads - loads) / rate : NAN));
+  };
+  {
+    SharedCounters counters(comm);
+    while (true) {
+      std::int64_t slot = 0;
+      if (group_root) slot = counters.fetch_add(next_shard, 1);
+      MPI_Bcast(&slot, 1, MPI_INT64_T, 0, group);
+      if (slot >= std::int64_t(todo.size())) break;
+      const std::int64_t k = todo[std::size_t(slot)];
+      const std::int64_t first = k * S, n = std::min(S, cfg.n_shapes - first);
+      std::unique_ptr<io::ShardWriter> writer;
+      if (group_root) {
+        io::ShardHeader h;
+        h.dataset_name = cfg.name;
+        h.config_text = cfg.text;
+        h.config_hash = hash;
+        h.seed = cfg.seed;
+        h.dim = cfg.shapes.dim;
+        h.shard_index = k;
+        h.first_shape = first;
+        h.n_shapes = n;
+        h.n_loads = cfg.loads.count;
+        h.software = software;
+        writer = std::make_unique<io::ShardWriter>(
+            (fs::path(opt.output_dir) / "shards" / shard_name(k)).string(), h);
+      }
+      for (std::int64_t id = first; id < first + n; ++id) {
+        ShapeJobResult r = run_shape(group, cfg, base, id, [&](bool ok) {
+          if (group_root) counters.fetch_add(ok ? loads_ok : loads_failed, 1);
+          print_progress(counters, false);
+        });
+        if (group_root) {
+          if (!r.entry.ok) counters.fetch_add(loads_failed, r.loads_failed);
+          counters.fetch_add(shapes_done, 1);
+          if (!r.entry.ok) counters.fetch_add(shapes_failed, 1);
+          auto t = times.scope("io");
+          writer->add(r.entry);
+        }
+        for (const auto& [name, s] : r.times.all()) times.add(name, s);
+        rep.shapes += 1;
+        rep.shapes_failed += r.entry.ok ? 0 : 1;
+        rep.loads_ok += r.loads_ok;
+        rep.loads_failed += r.loads_failed;
+        rep.newton_iterations += r.newton_iterations;
+        rep.solves += r.solves;
+        rep.failed_increments += r.failed_increments;
+        if (!r.entry.ok)
+          core::log_line(MPI_COMM_SELF, core::Verbosity::normal,
+                         fmt::format("[generate] shape {} failed: {}", id, r.entry.failure.substr(0, 300)));
+      }
+      if (group_root) {
+        auto t = times.scope("io");
+        writer->commit();
+        ++shards_written;
+      }
+    }
+    // Rank 0 keeps the progress line going until every group is done.
+    if (rank == 0 && opt.progress_seconds > 0) {
+      while (true) {
+        const auto v = counters.read();
+        if (v[shapes_done] >= todo_shapes) break;
+        print_progress(counters, false);
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      }
+    }
+    MPI_Barrier(comm);
+    if (rank == 0 && todo_shapes > 0) print_progress(counters, true);
+  }
+  MPI_Comm_free(&group);
+
+  // ---- the run report ---------------------------------------------------------------------------
+  double pc_setup = 0;
+  {
+    PetscLogEvent ev;
+    PetscEventPerfInfo info{};
+    if (PetscLogEventGetId("PCSetUp", &ev) == 0 && PetscLogEventGetPerfInfo(0, ev, &info) == 0) pc_setup = info.time;
+  }
+  // Counters: the group roots hold the group's numbers once.
+  auto sum_roots = [&](std::int64_t v) {
+    std::int64_t x = group_root ? v : 0, total = 0;
+    MPI_Allreduce(&x, &total, 1, MPI_INT64_T, MPI_SUM, comm);
+    return total;
+  };
+  rep.shapes = sum_roots(rep.shapes);
+  rep.shapes_failed = sum_roots(rep.shapes_failed);
+  rep.loads_ok = sum_roots(rep.loads_ok);
+  rep.loads_failed = sum_roots(rep.loads_failed);
+  rep.newton_iterations = sum_roots(rep.newton_iterations);
+  rep.solves = sum_roots(rep.solves);
+  rep.failed_increments = sum_roots(rep.failed_increments);
+  rep.shards_written = sum_roots(shards_written);
+  const std::vector<std::string> phases = {"shape", "mesh", "setup", "solve", "alpha_search",
+                                           "representations", "gather", "io"};
+  for (const auto& p : phases) {
+    double x = group_root ? times.get(p) : 0, total = 0;
+    MPI_Allreduce(&x, &total, 1, MPI_DOUBLE, MPI_SUM, comm);
+    rep.phase_seconds[p] = total;
+  }
+  MPI_Allreduce(&pc_setup, &rep.factorization_seconds, 1, MPI_DOUBLE, MPI_SUM, comm);
+  std::vector<double> rss(static_cast<std::size_t>(size));
+  double mine = peak_rss_mib();
+  MPI_Gather(&mine, 1, MPI_DOUBLE, rss.data(), 1, MPI_DOUBLE, 0, comm);
+  rep.seconds = core::now_seconds() - start;
+  double max_seconds = 0;
+  MPI_Allreduce(&rep.seconds, &max_seconds, 1, MPI_DOUBLE, MPI_MAX, comm);
+  rep.seconds = max_seconds;
+
+  // Index the dataset when every shard exists (the last task of an array does it).
+  int complete = 0;
+  core::on_root(comm, [&] {
+    if (rank == 0) {
+      nlohmann::json j;
+      j["dataset"] = cfg.name;
+      j["config"] = cfg.source;
+      j["task_index"] = opt.task_index;
+      j["task_count"] = opt.task_count;
+      j["ranks"] = size;
+      j["group_size"] = opt.group_size;
+      j["shards"] = {{"total", rep.shards_total}, {"done_before", rep.shards_done_before},
+                     {"written", rep.shards_written}};
+      j["shapes"] = {{"solved", rep.shapes}, {"failed", rep.shapes_failed}};
+      j["load_cases"] = {{"converged", rep.loads_ok}, {"failed", rep.loads_failed},
+                         {"per_second", (rep.loads_ok + rep.loads_failed) / std::max(1e-9, rep.seconds)}};
+      j["solver"] = {{"newton_iterations", rep.newton_iterations}, {"nonlinear_solves", rep.solves},
+                     {"failed_increments", rep.failed_increments}};
+      j["seconds"] = {{"wall", rep.seconds}, {"phases_summed_over_groups", rep.phase_seconds},
+                      {"factorization_PCSetUp_summed_over_ranks", rep.factorization_seconds}};
+      j["peak_rss_mib_per_rank"] = rss;
+      j["software"] = software;
+      rep.json = j.dump(2);
+      write_atomically(fs::path(opt.output_dir) / "reports" /
+                           fmt::format("task-{:03d}-of-{:03d}.json", opt.task_index, opt.task_count),
+                       rep.json + "\n");
+      bool all = true;
+      for (std::int64_t k = 0; k < rep.shards_total && all; ++k)
+        all = fs::exists(fs::path(opt.output_dir) / "shards" / shard_name(k));
+      if (all) {
+        index_dataset(opt.output_dir);
+        complete = 1;
+      }
+    }
+  });
+  MPI_Bcast(&complete, 1, MPI_INT, 0, comm);
+  rep.indexed = complete == 1;
+  return rep;
+}
+
+std::string report_table(const RunReport& r) {
+  std::string s;
+  const double loads = double(r.loads_ok + r.loads_failed);
+  s += fmt::format("  shapes {} ({} failed), load cases {} converged, {} failed, in {:.1f} s: {:.2f} load cases/s\n",
+                   r.shapes, r.shapes_failed, r.loads_ok, r.loads_failed, r.seconds, loads / std::max(1e-9, r.seconds));
+  s += fmt::format("  Newton iterations {} in {} nonlinear solves ({:.1f} per load case), {} failed increments\n",
+                   r.newton_iterations, r.solves, r.newton_iterations / std::max(1.0, loads), r.failed_increments);
+  double total = 0;
+  for (const auto& [k, v] : r.phase_seconds) total += v;
+  s += "  phase              seconds   share\n";
+  for (const auto& [k, v] : r.phase_seconds)
+    s += fmt::format("  {:<17s} {:8.2f}  {:5.1f}%\n", k, v, 100 * v / std::max(1e-9, total));
+  s += fmt::format("  (factorisations, PCSetUp: {:.2f} s of solve + alpha_search)\n", r.factorization_seconds);
+  return s;
+}
+
+}  // namespace hypershape::factory

@@ -1,0 +1,301 @@
+#include "hypershape/io/dataset_shard.hpp"
+
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <hdf5.h>
+#include <unistd.h>
+#include <zlib.h>
+
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <numeric>
+
+#include "h5_util.hpp"
+#include "shape_group.hpp"
+
+namespace hypershape::io {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+/// Creation property list without object timestamps: the same data gives the same bytes.
+Id untimed(hid_t cls) {
+  Id p{check_id(H5Pcreate(cls), "plist"), H5Pclose};
+  check(H5Pset_obj_track_times(p.id, false), "track times");
+  return p;
+}
+
+Id make_group(hid_t parent, const std::string& name) {
+  Id gcpl = untimed(H5P_GROUP_CREATE);
+  Id lcpl{check_id(H5Pcreate(H5P_LINK_CREATE), name), H5Pclose};
+  check(H5Pset_create_intermediate_group(lcpl.id, 1), name);
+  return {check_id(H5Gcreate2(parent, name.c_str(), lcpl.id, gcpl.id, H5P_DEFAULT), name), H5Gclose};
+}
+
+void write_array(hid_t g, const Array& a) {
+  const int rank = int(a.shape.size());
+  std::vector<hsize_t> dims(a.shape.begin(), a.shape.end());
+  const hsize_t n = std::accumulate(dims.begin(), dims.end(), hsize_t(1), std::multiplies<>());
+  hid_t type = -1;
+  const void* data = nullptr;
+  std::size_t size = 0, elem = 0;
+  std::visit(
+      [&](const auto& v) {
+        using T = typename std::decay_t<decltype(v)>::value_type;
+        data = v.data();
+        size = v.size();
+        elem = sizeof(T);
+        if constexpr (std::is_same_v<T, double>) type = H5T_NATIVE_DOUBLE;
+        else if constexpr (std::is_same_v<T, float>) type = H5T_NATIVE_FLOAT;
+        else if constexpr (std::is_same_v<T, std::int64_t>) type = H5T_NATIVE_INT64;
+        else type = H5T_NATIVE_INT8;
+      },
+      a.data);
+  if (size != n) throw std::runtime_error(fmt::format("array {}: {} values for shape of {}", a.name, size, n));
+  Id space{check_id(H5Screate_simple(rank, dims.data(), nullptr), a.name), H5Sclose};
+  Id dcpl = untimed(H5P_DATASET_CREATE);
+  if (n > 0) {
+    std::vector<hsize_t> chunk = dims;
+    if (a.name.rfind("loads/", 0) == 0 && rank >= 2) {
+      chunk[0] = 1;  // one load case per chunk: a training sample reads one chunk
+    } else {
+      const hsize_t rest = rank > 1 ? n / dims[0] : 1;
+      chunk[0] = std::clamp<hsize_t>((1u << 20) / std::max<hsize_t>(1, rest * elem / 4), 1, dims[0]);
+    }
+    check(H5Pset_chunk(dcpl.id, rank, chunk.data()), a.name);
+    check(H5Pset_shuffle(dcpl.id), a.name);
+    check(H5Pset_deflate(dcpl.id, 4), a.name);
+  }
+  Id lcpl{check_id(H5Pcreate(H5P_LINK_CREATE), a.name), H5Pclose};
+  check(H5Pset_create_intermediate_group(lcpl.id, 1), a.name);
+  Id ds{check_id(H5Dcreate2(g, a.name.c_str(), type, space.id, lcpl.id, dcpl.id, H5P_DEFAULT), a.name), H5Dclose};
+  if (n > 0) check(H5Dwrite(ds.id, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), a.name);
+  if (!a.meaning.empty()) attr_string(ds.id, "meaning", a.meaning);
+  if (!a.units.empty()) attr_string(ds.id, "units", a.units);
+}
+
+void write_strings(hid_t g, const char* name, const std::vector<std::string>& v) {
+  Id type{check_id(H5Tcopy(H5T_C_S1), name), H5Tclose};
+  check(H5Tset_size(type.id, H5T_VARIABLE), name);
+  check(H5Tset_cset(type.id, H5T_CSET_UTF8), name);
+  hsize_t dims[1] = {v.size()};
+  Id space{check_id(H5Screate_simple(1, dims, nullptr), name), H5Sclose};
+  Id dcpl = untimed(H5P_DATASET_CREATE);
+  Id lcpl{check_id(H5Pcreate(H5P_LINK_CREATE), name), H5Pclose};
+  check(H5Pset_create_intermediate_group(lcpl.id, 1), name);
+  Id ds{check_id(H5Dcreate2(g, name, type.id, space.id, lcpl.id, dcpl.id, H5P_DEFAULT), name), H5Dclose};
+  std::vector<const char*> ptrs;
+  for (const auto& s : v) ptrs.push_back(s.c_str());
+  if (!v.empty()) check(H5Dwrite(ds.id, type.id, H5S_ALL, H5S_ALL, H5P_DEFAULT, ptrs.data()), name);
+}
+
+double read_attr_double(hid_t obj, const char* name) {
+  Id a{check_id(H5Aopen(obj, name, H5P_DEFAULT), name), H5Aclose};
+  double v = 0;
+  check(H5Aread(a.id, H5T_NATIVE_DOUBLE, &v), name);
+  return v;
+}
+
+std::string read_attr_string(hid_t obj, const char* name) {
+  Id a{check_id(H5Aopen(obj, name, H5P_DEFAULT), name), H5Aclose};
+  Id type{check_id(H5Aget_type(a.id), name), H5Tclose};
+  std::string s(H5Tget_size(type.id), '\0');
+  check(H5Aread(a.id, type.id, s.data()), name);
+  while (!s.empty() && s.back() == '\0') s.pop_back();
+  return s == " " ? std::string() : s;
+}
+
+std::string hdf5_version() {
+  unsigned a, b, c;
+  H5get_libversion(&a, &b, &c);
+  return fmt::format("{}.{}.{}", a, b, c);
+}
+
+void fsync_path(const std::string& path, bool directory) {
+  const int fd = ::open(path.c_str(), directory ? O_RDONLY | O_DIRECTORY : O_RDONLY);
+  if (fd < 0) return;
+  ::fsync(fd);
+  ::close(fd);
+}
+
+}  // namespace
+
+struct ShardWriter::Impl {
+  std::string path, tmp;
+  hid_t file = -1, shapes = -1;
+  bool committed = false;
+};
+
+ShardWriter::ShardWriter(std::string path, const ShardHeader& h) : impl_(std::make_unique<Impl>()) {
+  impl_->path = std::move(path);
+  impl_->tmp = impl_->path + ".tmp";
+  impl_->file = check_id(H5Fcreate(impl_->tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
+                         "create " + impl_->tmp);
+  const hid_t f = impl_->file;
+  attr_string(f, "format", "hypershape-dataset");
+  attr_double(f, "format_version", dataset_format_version);
+  attr_string(f, "dataset_name", h.dataset_name);
+  attr_string(f, "config_hash", h.config_hash);
+  attr_double(f, "seed", double(h.seed));
+  attr_double(f, "dim", h.dim);
+  attr_double(f, "shard_index", double(h.shard_index));
+  attr_double(f, "first_shape", double(h.first_shape));
+  attr_double(f, "n_shapes", double(h.n_shapes));
+  attr_double(f, "n_loads", h.n_loads);
+  attr_double(f, "complete", 0);
+  {
+    Id sw = make_group(f, "software");
+    auto software = h.software;
+#ifdef HYPERSHAPE_VERSION
+    software["hypershape"] = HYPERSHAPE_VERSION;
+#endif
+    software["hdf5"] = hdf5_version();
+    for (const auto& [k, v] : software) attr_string(sw.id, k, v);
+  }
+  {
+    Id dcpl = untimed(H5P_DATASET_CREATE);
+    Id type{check_id(H5Tcopy(H5T_C_S1), "config"), H5Tclose};
+    check(H5Tset_size(type.id, std::max<std::size_t>(1, h.config_text.size())), "config");
+    Id space{check_id(H5Screate(H5S_SCALAR), "config"), H5Sclose};
+    Id ds{check_id(H5Dcreate2(f, "config", type.id, space.id, H5P_DEFAULT, dcpl.id, H5P_DEFAULT), "config"), H5Dclose};
+    check(H5Dwrite(ds.id, type.id, H5S_ALL, H5S_ALL, H5P_DEFAULT, h.config_text.empty() ? " " : h.config_text.c_str()), "config");
+  }
+  Id shapes = make_group(f, "shapes");
+  impl_->shapes = shapes.id;
+  shapes.id = -1;  // owned by the writer now
+}
+
+ShardWriter::~ShardWriter() {
+  if (!impl_ || impl_->committed) return;
+  if (impl_->shapes >= 0) H5Gclose(impl_->shapes);
+  if (impl_->file >= 0) H5Fclose(impl_->file);
+  std::error_code ec;
+  fs::remove(impl_->tmp, ec);
+}
+
+void ShardWriter::add(const ShardShape& s) {
+  Id g = make_group(impl_->shapes, fmt::format("{:06d}", s.shape.shape_id));
+  attr_string(g.id, "status", s.ok ? "ok" : "failed");
+  if (!s.ok) {
+    attr_string(g.id, "failure", s.failure);
+    attr_double(g.id, "shape_id", double(s.shape.shape_id));
+    write_string_dataset(g.id, "rejected", s.shape.rejected);
+    for (const auto& [k, v] : s.shape.numbers) attr_double(g.id, k, v);
+    return;
+  }
+  write_shape_group(g.id, s.shape);
+  for (const Array& a : s.arrays) write_array(g.id, a);
+  write_strings(g.id, "loads/reason", s.load_reasons);
+}
+
+void ShardWriter::commit() {
+  const hid_t f = impl_->file;
+  {
+    Id a{check_id(H5Aopen(f, "complete", H5P_DEFAULT), "complete"), H5Aclose};
+    const double one = 1;
+    check(H5Awrite(a.id, H5T_NATIVE_DOUBLE, &one), "complete");
+  }
+  H5Gclose(impl_->shapes);
+  impl_->shapes = -1;
+  check(H5Fflush(f, H5F_SCOPE_GLOBAL), "flush " + impl_->tmp);
+  impl_->file = -1;
+  check(H5Fclose(f), "close " + impl_->tmp);
+  fsync_path(impl_->tmp, false);
+  fs::rename(impl_->tmp, impl_->path);
+  fsync_path(fs::path(impl_->path).parent_path().string(), true);
+  impl_->committed = true;
+}
+
+ShardSummary read_shard_summary(const std::string& path) {
+  Id file{check_id(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), "open " + path), H5Fclose};
+  ShardSummary out;
+  auto& h = out.header;
+  if (read_attr_string(file.id, "format") != "hypershape-dataset")
+    throw std::runtime_error(path + ": not a hypershape dataset shard");
+  if (int(read_attr_double(file.id, "format_version")) != dataset_format_version)
+    throw std::runtime_error(path + ": unsupported format_version");
+  if (read_attr_double(file.id, "complete") != 1) throw std::runtime_error(path + ": incomplete shard");
+  h.dataset_name = read_attr_string(file.id, "dataset_name");
+  h.config_hash = read_attr_string(file.id, "config_hash");
+  h.seed = std::uint64_t(read_attr_double(file.id, "seed"));
+  h.dim = int(read_attr_double(file.id, "dim"));
+  h.shard_index = std::int64_t(read_attr_double(file.id, "shard_index"));
+  h.first_shape = std::int64_t(read_attr_double(file.id, "first_shape"));
+  h.n_shapes = std::int64_t(read_attr_double(file.id, "n_shapes"));
+  h.n_loads = int(read_attr_double(file.id, "n_loads"));
+  h.config_text = read_string(file.id, "config");
+  Id all{check_id(H5Gopen2(file.id, "shapes", H5P_DEFAULT), "shapes"), H5Gclose};
+  H5G_info_t info;
+  check(H5Gget_info(all.id, &info), "shapes");
+  for (hsize_t i = 0; i < info.nlinks; ++i) {
+    char name[64];
+    H5Lget_name_by_idx(all.id, ".", H5_INDEX_NAME, H5_ITER_INC, i, name, sizeof name, H5P_DEFAULT);
+    Id g{check_id(H5Gopen2(all.id, name, H5P_DEFAULT), name), H5Gclose};
+    ShardSummary::Shape s;
+    s.shape_id = std::int64_t(read_attr_double(g.id, "shape_id"));
+    s.ok = read_attr_string(g.id, "status") == "ok";
+    if (s.ok) {
+      const auto status = read_array<std::int8_t>(g.id, "loads/status", H5T_NATIVE_INT8);
+      for (auto v : status) (v == 1 ? s.loads_ok : s.loads_failed) += 1;
+      if (H5Lexists(g.id, "stats", H5P_DEFAULT) > 0) {
+        Id st{check_id(H5Gopen2(g.id, "stats", H5P_DEFAULT), "stats"), H5Gclose};
+        H5G_info_t si;
+        check(H5Gget_info(st.id, &si), "stats");
+        for (hsize_t k = 0; k < si.nlinks; ++k) {
+          char field[128];
+          H5Lget_name_by_idx(st.id, ".", H5_INDEX_NAME, H5_ITER_INC, k, field, sizeof field, H5P_DEFAULT);
+          s.stats[field] = read_array<double>(st.id, field, H5T_NATIVE_DOUBLE);
+        }
+      }
+    } else {
+      s.loads_failed = h.n_loads;
+    }
+    out.shapes.push_back(std::move(s));
+  }
+  return out;
+}
+
+bool is_complete_shard(const std::string& path, const std::string& config_hash) {
+  if (!fs::exists(path)) return false;
+  bool ok = false;
+  H5E_BEGIN_TRY {
+    const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+    if (f >= 0) {
+      try {
+        ok = read_attr_double(f, "complete") == 1 && read_attr_string(f, "config_hash") == config_hash &&
+             read_attr_string(f, "format") == "hypershape-dataset";
+      } catch (...) {
+        ok = false;
+      }
+      H5Fclose(f);
+    }
+  }
+  H5E_END_TRY;
+  return ok;
+}
+
+std::uint32_t file_crc32(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot read " + path);
+  uLong crc = crc32(0L, Z_NULL, 0);
+  std::vector<char> buf(1 << 20);
+  while (in) {
+    in.read(buf.data(), std::streamsize(buf.size()));
+    const auto n = in.gcount();
+    if (n > 0) crc = crc32(crc, reinterpret_cast<const Bytef*>(buf.data()), uInt(n));
+  }
+  return std::uint32_t(crc);
+}
+
+std::string text_digest(const std::string& text) {
+  std::uint64_t h = 1469598103934665603ULL;
+  for (unsigned char c : text) {
+    h ^= c;
+    h *= 1099511628211ULL;
+  }
+  return fmt::format("{:016x}", h);
+}
+
+}  // namespace hypershape::io
