@@ -320,7 +320,7 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
     auto t = out.times.scope("representations");
     const U64 nl_ = U64(n_loads), du = U64(d);
     arrays.push_back({"loads/status", {nl_}, status, "1 converged (target reached), 0 failed (see loads/reason)", ""});
-    arrays.push_back({"loads/alpha", {nl_}, alpha, "traction scale alpha (0 if failed)", "force/length^(d-1)"});
+    arrays.push_back({"loads/alpha", {nl_}, alpha, "traction scale alpha = the total applied force |int t dS| (0 if failed)", "force"});
     arrays.push_back({"loads/target", {nl_}, target, "wanted max|u|", "length"});
     arrays.push_back({"loads/max_displacement", {nl_}, max_u, "achieved max over the nodes of |u| (0 if failed)", "length"});
     arrays.push_back({"loads/min_det_f", {nl_}, min_det, "min det F over the quadrature points (0 if failed)", ""});

@@ -139,6 +139,7 @@ ShardWriter::ShardWriter(std::string path, const ShardHeader& h) : impl_(std::ma
   attr_string(f, "dataset_name", h.dataset_name);
   attr_string(f, "config_hash", h.config_hash);
   attr_double(f, "seed", double(h.seed));
+  attr_string(f, "seed_exact", std::to_string(h.seed));  // a float64 holds only 53 bits
   attr_double(f, "dim", h.dim);
   attr_double(f, "shard_index", double(h.shard_index));
   attr_double(f, "first_shape", double(h.first_shape));

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string_view>
 
 #include "h5_util.hpp"
 
@@ -17,7 +18,14 @@ namespace {
 namespace fs = std::filesystem;
 
 std::vector<hsize_t> dims_of(hid_t g, const char* name) {
-  if (H5Lexists(g, name, H5P_DEFAULT) <= 0) return {};
+  // H5Lexists needs every intermediate group to exist: check the path step by step.
+  std::string path;
+  for (std::string_view rest = name; !rest.empty();) {
+    const auto slash = rest.find('/');
+    path += (path.empty() ? "" : "/") + std::string(rest.substr(0, slash));
+    if (H5Lexists(g, path.c_str(), H5P_DEFAULT) <= 0) return {};
+    rest = slash == std::string_view::npos ? std::string_view() : rest.substr(slash + 1);
+  }
   Id ds{check_id(H5Dopen2(g, name, H5P_DEFAULT), name), H5Dclose};
   Id sp{check_id(H5Dget_space(ds.id), name), H5Sclose};
   std::vector<hsize_t> d(std::size_t(H5Sget_simple_extent_ndims(sp.id)));

@@ -507,9 +507,10 @@ MeshSampler::MeshSampler(int dim, int degree, std::span<const double> nodes,
   double diag2 = 0;
   {
     std::array<double, 3> lo{HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
-    for (std::size_t i = 0; i < boundary.points.size(); ++i)
-      lo[i % d] = std::min(lo[i % d], boundary.points[i]),
-             hi[i % d] = std::max(hi[i % d], boundary.points[i]);
+    for (std::size_t i = 0; i < boundary.points.size(); ++i) {
+      lo[i % d] = std::min(lo[i % d], boundary.points[i]);
+      hi[i % d] = std::max(hi[i % d], boundary.points[i]);
+    }
     for (std::size_t k = 0; k < d; ++k) diag2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
   }
   const double near_boundary = 1e-10 * std::sqrt(diag2);

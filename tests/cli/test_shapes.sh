@@ -66,7 +66,7 @@ expect no_steps         's/steps: \[\[0.2, 1\]\]/steps: []/'            "shapes.
 expect h_range          's/h: 0.1/h: 5/'                               "shapes.h"
 expect count_zero       's/count: 2/count: 0/'                         "shapes.count"
 expect missing_seed     '/^seed/d'                                     "seed"
-expect top_unknown      '$a loads: {}'                                 "loads"
+expect top_unknown      '$a colour: red'                              "colour"
 expect missing_surface  's/dim: 2/dim: 3/; s/base: circle/base: file\n  base_file: nowhere.stl/' "shapes.base_file"
 printf 'solid x\nendsolid x\n' > "$work/empty.stl"
 expect empty_surface    "s|dim: 2|dim: 3|; s|base: circle|base: file\n  base_file: $work/empty.stl|" "empty.stl"

