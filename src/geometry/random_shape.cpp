@@ -5,8 +5,8 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
-#include <queue>
 #include <stdexcept>
+#include <string>
 #include <unordered_map>
 
 namespace hypershape::geometry {
@@ -360,10 +360,13 @@ SurfaceSamples sample_surface_image(RandomDeformation& phi, const Boundary& base
   for (std::size_t i = 0; i < img.size(); i += 3) phi.flow(&img[i]);
 
   std::unordered_map<std::uint64_t, std::array<int, 2>> edge_tris;
-  edge_tris.reserve(tri.size());
+  edge_tris.reserve(2 * tri.size());
   auto add_edge_tri = [&](int a, int b, int t) {
     auto [it, inserted] = edge_tris.try_emplace(edge_key(a, b), std::array<int, 2>{t, -1});
-    if (!inserted) it->second[1] = t;
+    if (!inserted) {
+      if (it->second[1] >= 0) throw std::runtime_error("base surface is not a 2-manifold");
+      it->second[1] = t;
+    }
   };
   auto replace_edge_tri = [&](int a, int b, int old_t, int new_t) {
     auto& e = edge_tris.at(edge_key(a, b));
@@ -372,50 +375,57 @@ SurfaceSamples sample_surface_image(RandomDeformation& phi, const Boundary& base
   const int n_tri0 = int(tri.size() / 3);
   for (int t = 0; t < n_tri0; ++t)
     for (int q = 0; q < 3; ++q) add_edge_tri(tri[3 * t + q], tri[3 * t + (q + 1) % 3], t);
+  for (const auto& [key, tris] : edge_tris)
+    if (tris[1] < 0) throw std::runtime_error("base surface is not closed");
 
-  auto length = [&](int a, int b) {
-    const double* x = &img[3 * std::size_t(a)];
-    const double* y = &img[3 * std::size_t(b)];
-    return std::sqrt((x[0] - y[0]) * (x[0] - y[0]) + (x[1] - y[1]) * (x[1] - y[1]) +
-                     (x[2] - y[2]) * (x[2] - y[2]));
+  auto dist2 = [](const std::vector<double>& x, int a, int b) {
+    const double* p = &x[3 * std::size_t(a)];
+    const double* q = &x[3 * std::size_t(b)];
+    return (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]);
   };
-  struct Item {
-    double len;
-    int a, b;
-    bool operator<(const Item& o) const {
-      return len != o.len ? len < o.len : (a != o.a ? a < o.a : b < o.b);
+  const double limit2 = flowed_spacing * flowed_spacing;
+  // A triangle is resolved when its image edges are no longer than the spacing.
+  auto unresolved = [&](int t) {
+    const int* v = &tri[3 * std::size_t(t)];
+    return dist2(img, v[0], v[1]) > limit2 || dist2(img, v[1], v[2]) > limit2 ||
+           dist2(img, v[2], v[0]) > limit2;
+  };
+  // The longest edge of a triangle in the PRE-IMAGE (ties broken by vertex ids, so that "the
+  // longest edge" is a strict total order): returns the position q of edge (v[q], v[q+1]).
+  auto longest = [&](int t) {
+    const int* v = &tri[3 * std::size_t(t)];
+    int best = 0;
+    double best_len = -1.0;
+    std::uint64_t best_key = 0;
+    for (int q = 0; q < 3; ++q) {
+      const double l = dist2(pre, v[q], v[(q + 1) % 3]);
+      const std::uint64_t k = edge_key(v[q], v[(q + 1) % 3]);
+      if (l > best_len || (l == best_len && k > best_key)) best = q, best_len = l, best_key = k;
     }
+    return best;
   };
-  std::priority_queue<Item> heap;
-  for (const auto& [key, tris] : edge_tris) {
-    (void)tris;
-    const int a = int(key >> 32), b = int(key & 0xffffffffu);
-    const double l = length(a, b);
-    if (l > flowed_spacing) heap.push({l, a, b});
-  }
   // Position of the directed edge a->b inside triangle t, or -1.
   auto directed = [&](int t, int a, int b) {
     for (int q = 0; q < 3; ++q)
       if (tri[3 * t + q] == a && tri[3 * t + (q + 1) % 3] == b) return q;
     return -1;
   };
-  while (!heap.empty()) {
-    const Item it = heap.top();
-    heap.pop();
-    auto found = edge_tris.find(edge_key(it.a, it.b));
-    if (found == edge_tris.end()) continue;  // already split
+  std::vector<int> queue;  // triangles to look at, first in first out
+  for (int t = 0; t < n_tri0; ++t)
+    if (unresolved(t)) queue.push_back(t);
+  // Splits edge (a, b) at the midpoint of its pre-image (projected per `kind`) and both of its
+  // triangles in two; queues the four triangles.
+  auto bisect = [&](int a, int b) {
     if (std::int64_t(pre.size() / 3) >= max_points)
-      throw std::runtime_error("surface needs too many points to resolve");
-    const auto tris = found->second;
+      throw std::runtime_error(
+          "surface needs too many points to resolve (more than " + std::to_string(max_points) + ")");
+    const auto tris = edge_tris.at(edge_key(a, b));
     int t1 = tris[0], t2 = tris[1];
-    if (t2 < 0) throw std::runtime_error("base surface is not closed");
-    int a = it.a, b = it.b;
     if (directed(t1, a, b) < 0) std::swap(t1, t2);  // t1 holds a->b, t2 holds b->a
     const int q1 = directed(t1, a, b), q2 = directed(t2, b, a);
-    assert(q1 >= 0 && q2 >= 0);
+    if (q1 < 0 || q2 < 0) throw std::runtime_error("base surface is not consistently oriented");
     const int c = tri[3 * t1 + (q1 + 2) % 3];
     const int d = tri[3 * t2 + (q2 + 2) % 3];
-    // New point: midpoint of the pre-images, on the base.
     const int m = int(pre.size() / 3);
     double p[3];
     for (int k = 0; k < 3; ++k) p[k] = 0.5 * (pre[3 * std::size_t(a) + k] + pre[3 * std::size_t(b) + k]);
@@ -432,16 +442,38 @@ SurfaceSamples sample_surface_image(RandomDeformation& phi, const Boundary& base
     tri[3 * t1 + 0] = a, tri[3 * t1 + 1] = m, tri[3 * t1 + 2] = c;
     tri[3 * t2 + 0] = b, tri[3 * t2 + 1] = m, tri[3 * t2 + 2] = d;
     tri.insert(tri.end(), {m, b, c, m, a, d});
-    edge_tris.erase(found);
+    edge_tris.erase(edge_key(a, b));
     replace_edge_tri(b, c, t1, t3);
     replace_edge_tri(a, d, t2, t4);
     edge_tris[edge_key(a, m)] = {t1, t4};
     edge_tris[edge_key(m, b)] = {t3, t2};
     edge_tris[edge_key(m, c)] = {t1, t3};
     edge_tris[edge_key(m, d)] = {t2, t4};
-    for (int v : {a, b, c, d}) {
-      const double l = length(m, v);
-      if (l > flowed_spacing) heap.push({l, std::min(m, v), std::max(m, v)});
+    queue.insert(queue.end(), {t1, t2, t3, t4});
+  };
+  // Longest-edge propagation path bisection (Rivara): a triangle is refined by bisecting the
+  // terminal edge of its LEPP, the first edge on the path that is the longest edge of both of its
+  // triangles, until it is resolved. Bisecting only longest pre-image edges keeps the pre-image
+  // triangles shape-regular (angles bounded below by half the smallest angle of the base), so
+  // their diameters shrink geometrically and the refinement ends wherever phi is continuous.
+  // (Bisecting the longest IMAGE edge instead does not end where the image folds back on itself
+  // closer than `spacing`: the points then pile up on a pre-image edge whose image is short.)
+  for (std::size_t head = 0; head < queue.size(); ++head) {
+    const int t = queue[head];
+    while (unresolved(t)) {
+      int cur = t;
+      for (;;) {
+        const int q = longest(cur);
+        const int a = tri[3 * cur + q], b = tri[3 * cur + (q + 1) % 3];
+        const auto& tris = edge_tris.at(edge_key(a, b));
+        const int other = tris[0] == cur ? tris[1] : tris[0];
+        const int qo = longest(other);
+        if (edge_key(tri[3 * other + qo], tri[3 * other + (qo + 1) % 3]) == edge_key(a, b)) {
+          bisect(a, b);
+          break;
+        }
+        cur = other;
+      }
     }
   }
   double lo[3], hi[3];

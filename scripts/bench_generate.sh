@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# Benchmark of the data factory: a Random2D slice (default 20 shapes x 50 load cases, the
+# preset's h and 128^2 grids) generated on 1 and on 2 ranks, side by side. Prints the load
+# cases per second, the per-phase split, peak memory per rank, the 2-rank efficiency and the
+# projected time of the full Random2D (1000 x 50); writes the figures as JSON.
+#   scripts/bench_generate.sh [SHAPES] [LOADS]    (JSON: results/bench_generate.json)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+shapes=${1:-20} loads=${2:-50}
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+cat > "$work/slice.yaml" <<YAML
+preset: random2d
+name: bench_random2d
+shapes: {count: $shapes}
+loads: {count: $loads}
+output: {shard_size: 2}
+YAML
+build/hypershape -q generate "$work/slice.yaml" --progress 0 -o "$work/np1"
+mpiexec -n 2 build/hypershape -q generate "$work/slice.yaml" --progress 0 -o "$work/np2"
+mkdir -p results
+/usr/bin/python3 - "$work" "$shapes" "$loads" <<'PY'
+import json, sys
+work, shapes, loads = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
+r = {n: json.load(open(f"{work}/np{n}/reports/task-000-of-001.json")) for n in (1, 2)}
+out = {"slice": {"shapes": shapes, "load_cases_per_shape": loads}, "runs": r}
+rate = {n: r[n]["load_cases"]["per_second"] for n in (1, 2)}
+out["efficiency_2_ranks"] = rate[2] / (2 * rate[1])
+out["projected_hours_random2d_1000x50"] = {n: 50000 / rate[n] / 3600 for n in (1, 2)}
+json.dump(out, open("results/bench_generate.json", "w"), indent=1)
+print(f"Random2D slice: {shapes} shapes x {loads} load cases")
+print("| ranks | load cases/s | wall s | converged | failed | Newton it./case | peak RSS MiB/rank | full Random2D (h) |")
+print("|---|---|---|---|---|---|---|---|")
+for n in (1, 2):
+    x = r[n]
+    lc = x["load_cases"]["converged"] + x["load_cases"]["failed"]
+    print(f"| {n} | {rate[n]:.2f} | {x['seconds']['wall']:.1f} | {x['load_cases']['converged']} | {x['load_cases']['failed']} "
+          f"| {x['solver']['newton_iterations'] / max(lc, 1):.1f} | {', '.join(f'{m:.0f}' for m in x['peak_rss_mib_per_rank'])} "
+          f"| {out['projected_hours_random2d_1000x50'][n]:.2f} |")
+print(f"2 ranks: {100 * out['efficiency_2_ranks']:.0f}% of twice the 1-rank rate")
+print("\nPhase split (seconds summed over ranks):")
+print("| phase | 1 rank | share | 2 ranks | share |")
+print("|---|---|---|---|---|")
+ph = {n: r[n]["seconds"]["phases_summed_over_groups"] for n in (1, 2)}
+tot = {n: sum(ph[n].values()) for n in (1, 2)}
+for k in ph[1]:
+    print(f"| {k} | {ph[1][k]:.1f} | {100 * ph[1][k] / tot[1]:.0f}% | {ph[2][k]:.1f} | {100 * ph[2][k] / tot[2]:.0f}% |")
+for n in (1, 2):
+    print(f"factorisations (PCSetUp) on {n} rank(s): {r[n]['seconds']['factorization_PCSetUp_summed_over_ranks']:.1f} s "
+          f"= {100 * r[n]['seconds']['factorization_PCSetUp_summed_over_ranks'] / tot[n]:.0f}% of the phases")
+print("JSON: results/bench_generate.json")
+PY
