@@ -7,8 +7,9 @@
 # For each preset, draws and meshes shapes 0..N-1 with `hypershape shapes` (N = 200 for the 2D
 # presets, 1 for one_random2d, 30 for the 3D presets), then scripts/shape_gallery.py writes
 # docs/figures/<name>_gallery.png (the first 16 shapes) and <name>_histogram.png (all N).
-# A preset whose base surface file is missing (aug_liver without configs/surfaces/organ.stl) is
-# skipped with a note. Prints the time of each preset and the total.
+# A preset whose base surface file is missing is skipped with a note (aug_liver's
+# configs/surfaces/organ.stl is made by scripts/make_organ_surface.py). Prints the time of each
+# preset and the total.
 #
 # Environment:
 #   HYPERSHAPE_BIN   the CLI (default build/hypershape)
@@ -16,8 +17,9 @@
 #   N2D, N3D         shapes per 2D / 3D preset (default 200 / 30; at least 16 for the gallery)
 #   PRESETS          preset names (default: all six)
 #   PRESET_TIMEOUT   seconds per preset, 0 = none (default 900); a preset that runs out is
-#                    reported and skipped (a killed run writes no file). A 3D shape whose every
-#                    draw fails can take ~8 min (20 attempts), hence the cap.
+#                    reported and skipped (a killed run writes no file). 30 Random3D shapes take
+#                    about 3.5 min on one core (AugLiver 40 s); a 3D shape whose every draw fails
+#                    takes about a minute (20 attempts).
 #   SHAPES_DIR       where the .h5 files and the CLI logs go (default results/shapes; ignored)
 #   OUT_DIR          figures (default docs/figures)
 set -euo pipefail

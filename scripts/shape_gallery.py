@@ -9,7 +9,8 @@ For every file (root attribute `name` = NAME) it writes
                               file holds fewer shapes)
       2D: the filled boundary polygon, the Dirichlet patch facets drawn thick in another
           colour and p_D as a dot; axes [-1.05, 1.05]^2, equal aspect; title "id, iso ratio".
-      3D: the boundary surface (Poly3DCollection, shaded by the facet normal), the Dirichlet
+      3D: the boundary surface (Poly3DCollection; each triangle lit by the mean of its vertex
+          normals, so the shading follows the surface rather than the facets), the Dirichlet
           patch facets in another colour, seen from p_D's side (30 degrees off, so the patch
           is in view); box [-1, 1]^3; title "id, Hausdorff distance to the base".
       A failed shape (attribute failed == 1) is an empty panel labelled "failed".
@@ -70,11 +71,19 @@ def load(path):
     return name, dim, shapes
 
 
+def rejected_stages(s):
+    """The stage of each rejected draw of a shape, from its `rejected` text: lines
+    "ATTEMPT STAGE: reason" (shape files) or "attempt ATTEMPT (STAGE): reason" (error messages)."""
+    text = s["rejected"]
+    stages = re.findall(r"^\s*\d+ (\w+): ", text, flags=re.M)
+    return stages or re.findall(r"attempt \d+ \((\w+)\)", text)
+
+
 def redraws(s):
     """Rejected draws of a shape: n_rejected, or the lines of `rejected` for a failed one."""
     if "n_rejected" in s["attrs"]:
         return int(s["attrs"]["n_rejected"])
-    return len(re.findall(r"attempt \d+ \(", s["rejected"]))
+    return len(rejected_stages(s))
 
 
 def metric(s, dim):
@@ -86,7 +95,7 @@ def metric(s, dim):
 def failed_panel(ax, s):
     ax.set_axis_off()
     # The stages of its rejected draws, e.g. "20 draws: feature 18, quality 2".
-    stages = re.findall(r"attempt \d+ \((\w+)\)", s["rejected"])
+    stages = rejected_stages(s)
     detail = ", ".join(f"{k} {stages.count(k)}" for k in sorted(set(stages), key=stages.index))
     text = "failed" + (f"\n{len(stages)} draws: {detail}" if stages else "")
     put = getattr(ax, "text2D", ax.text)  # 3D axes take 2D text through text2D
@@ -130,11 +139,24 @@ def shade(rgb, normals, light):
     return np.clip(base * (0.35 + 0.65 * lam[:, None]), 0, 1)
 
 
+def smooth_normals(pts, fac):
+    """Per triangle, the mean of its three vertex normals (area-weighted facet normals around
+    each vertex): lighting with these shades the surface the triangles sample rather than the
+    facets (the boundary is resolved at h, so flat shading shows mostly the triangulation)."""
+    tri = pts[fac]
+    fn = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])  # 2 * area * unit normal
+    vn = np.zeros_like(pts)
+    for k in range(3):
+        np.add.at(vn, fac[:, k], fn)
+    vn /= np.maximum(np.linalg.norm(vn, axis=1, keepdims=True), 1e-300)
+    n = vn[fac].mean(axis=1)
+    return n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+
+
 def draw_3d(ax, s):
     pts, fac = s["boundary/points"], s["boundary/facets"].astype(int)
     tri = pts[fac]  # m x 3 x 3
-    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+    n = smooth_normals(pts, fac)
     # Look at the shape from p_D's side, lit from the camera and above.
     c = np.asarray(s["attrs"].get("dirichlet_center", [0.0, 0.0, 0.0]), dtype=float)
     has_patch = s["attrs"].get("dirichlet_radius", 0) > 0 and np.linalg.norm(c) > 1e-9

@@ -56,6 +56,8 @@ void RandomDeformation::normalise_box(std::span<const double> lo, std::span<cons
   scale_ = 1.0 / half;
 }
 
+double default_velocity_unit(int dim) { return dim == 2 ? 0.04 : 0.0125; }
+
 RandomDeformation sample_deformation(const DeformationSpec& spec,
                                      std::span<const double> base_points,
                                      core::RandomStream& rng) {
@@ -66,14 +68,18 @@ RandomDeformation sample_deformation(const DeformationSpec& spec,
   std::vector<double> pts(base_points.begin(), base_points.end());
   double lo[3], hi[3];
   const double nodes_per_sigma = spec.nodes_per_sigma > 0 ? spec.nodes_per_sigma : (dim == 2 ? 6.0 : 3.0);
+  const double margin_sigmas = spec.margin_sigmas > 0 ? spec.margin_sigmas : (dim == 2 ? 3.0 : 1.0);
+  const double unit = std::isnan(spec.velocity_unit) ? default_velocity_unit(dim) : spec.velocity_unit;
+  if (!(unit >= 0.0) || !std::isfinite(unit))
+    throw std::invalid_argument("velocity_unit must be finite and >= 0");
   for (const DeformationStep& step : spec.steps) {
     if (!(step.sigma > 0.0) || !(step.m >= 0.0))
       throw std::invalid_argument("deformation step needs sigma > 0 and m >= 0");
-    const double std_v = step.m * spec.velocity_unit;
+    const double std_v = step.m * unit;
     bounding_box(dim, pts, lo, hi);
     // Particles travel at most max|v| in unit time; 5 standard deviations bound max|v| over the
     // grid with overwhelming probability, and beyond the grid v is continued by a constant.
-    const double margin = spec.margin_sigmas * step.sigma + 5.0 * std_v;
+    const double margin = margin_sigmas * step.sigma + 5.0 * std_v;
     for (int a = 0; a < dim; ++a) {
       lo[a] -= margin;
       hi[a] += margin;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "hypershape/config/dataset.hpp"
+#include "hypershape/core/timer.hpp"
 #include "hypershape/factory/shape_pipeline.hpp"
 #include "hypershape/geometry/boundary_check.hpp"
 #include "hypershape/geometry/metrics.hpp"
@@ -50,12 +51,14 @@ void check_shape(const factory::ShapeSample& s, const factory::ShapeConfig& c) {
   const auto check = geometry::check_boundary(b);
   INFO(check.reason);
   REQUIRE(check.ok);
-  // Normalised into [-1, 1]^d, touching the box (in 3D the remeshed surface may cut the
-  // extreme points off by a fraction of h).
+  // Normalised into [-1, 1]^d, touching the box. In 3D the box is that of the dense exact
+  // samples; the surface remeshed at h cuts a tip of curvature radius R by about h^2 / (8 R),
+  // and R >= h/4 (thinner features are redrawn), so by at most h/2 (measured: 0.0275 = 0.28 h,
+  // the largest over 30 Random3D draws).
   double extent = 0.0;
   for (double x : b.points) extent = std::max(extent, std::abs(x));
   CHECK(extent <= 1.0 + 1e-3);
-  CHECK(extent >= 1.0 - (b.dim == 2 ? 1e-3 : c.h / 10));
+  CHECK(extent >= 1.0 - (b.dim == 2 ? 1e-3 : c.h / 2));
   // The mesh keeps the boundary: vertex i is boundary point i, and it fills the enclosed region.
   REQUIRE(s.mesh.n_vertices() >= b.n_points());
   for (std::size_t i = 0; i < b.points.size(); ++i) REQUIRE(s.mesh.coords[i] == b.points[i]);
@@ -143,21 +146,36 @@ TEST_CASE("a shape is a pure function of (seed, shape id)", "[factory][shapes]")
   CHECK(c.boundary.points != a.boundary.points);
 }
 
-TEST_CASE("a 3D shape is watertight and meshed conformingly", "[factory][shapes]") {
-  // A milder family than Random3D (one coarse step, h = 0.2) keeps the default suite fast; the
-  // [slow] test below runs the presets.
-  auto cfg = preset("random3d");
-  cfg.shapes.h = 0.2;
-  cfg.shapes.deformation.steps = {{0.3, 2.0}};
-  const auto s = factory::make_shape(cfg.shapes, std::nullopt, cfg.seed, 0);
-  check_shape(s, cfg.shapes);
-  CHECK(s.metrics.hausdorff_to_base > 0.0);
+/// Draws shapes 0..n-1 of a 3D preset and checks every one; prints the Hausdorff distances,
+/// redraws and times.
+void check_3d_preset(const std::string& name, int n) {
+  const auto cfg = preset(name);
+  const auto base = factory::load_base(cfg.shapes);
+  std::vector<double> hausdorff, seconds;
+  int redraws = 0;
+  for (std::int64_t id = 0; id < n; ++id) {
+    const double t0 = core::now_seconds();
+    const factory::ShapeSample s = factory::make_shape(cfg.shapes, base, cfg.seed, id);
+    seconds.push_back(core::now_seconds() - t0);
+    check_shape(s, cfg.shapes);
+    CHECK(s.metrics.hausdorff_to_base > 0.0);
+    hausdorff.push_back(s.metrics.hausdorff_to_base);
+    redraws += s.attempt;
+  }
+  std::sort(hausdorff.begin(), hausdorff.end());
+  std::sort(seconds.begin(), seconds.end());
+  WARN(name << ": Hausdorff distance to the base min " << hausdorff.front() << " median "
+            << hausdorff[hausdorff.size() / 2] << " max " << hausdorff.back() << "; " << redraws
+            << " redraws in " << n << " shapes; seconds per shape median "
+            << seconds[seconds.size() / 2] << " max " << seconds.back());
+}
+
+TEST_CASE("3D preset shapes are watertight and meshed conformingly", "[factory][shapes]") {
+  // One shape of each 3D preset as specified (about 7 s for both on one core).
+  check_3d_preset("random3d", 1);
+  check_3d_preset("aug_liver", 1);
 }
 
 TEST_CASE("30 draws per 3D preset are watertight", "[factory][shapes][slow]") {
-  for (const char* name : {"random3d", "aug_liver"}) {
-    const auto cfg = preset(name);
-    const auto base = factory::load_base(cfg.shapes);
-    for (std::int64_t id = 0; id < 30; ++id) check_shape(factory::make_shape(cfg.shapes, base, cfg.seed, id), cfg.shapes);
-  }
+  for (const char* name : {"random3d", "aug_liver"}) check_3d_preset(name, 30);
 }

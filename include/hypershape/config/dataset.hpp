@@ -12,7 +12,7 @@
 ///   dim: 2                        # 2 | 3
 ///   base: circle                  # circle (2D) | sphere (3D) | file (3D, + base_file: PATH)
 ///   steps: [[0.2, 4], [0.1, 1]]   # (sigma, m) per deformation, coarse first
-///   velocity_unit: 0.04           # velocity std = m * velocity_unit (optional)
+///   velocity_unit: 0.04           # velocity std = m * velocity_unit (optional; 0.04 2D, 0.0125 3D)
 ///   nodes_per_sigma: 6            # velocity grid resolution (optional; 6 in 2D, 3 in 3D)
 ///   h: 0.04                       # element size, in the normalised box [-1, 1]^d
 ///   dirichlet_radius: 0.5         # r (0: no Dirichlet patch)

@@ -9,6 +9,7 @@
 /// result lies exactly (to round-off) on Phi(base).
 #include <array>
 #include <functional>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -25,17 +26,25 @@ struct DeformationStep {
   double m = 1.0;
 };
 
+/// The unit of m when DeformationSpec::velocity_unit is not set: 0.04 in 2D, 0.0125 in 3D
+/// (measured side by side against the paper's descriptions; see README, "Random shapes").
+double default_velocity_unit(int dim);
+
 /// How the velocity fields are sampled and integrated.
 struct DeformationSpec {
   int dim = 2;
   std::vector<DeformationStep> steps;  ///< applied in order (coarse first, as in the paper)
   /// Units of m: the velocity standard deviation is m * velocity_unit (base radius 1). The paper
-  /// does not state the unit; 0.04 matches its descriptions (see README, "Random shapes").
-  double velocity_unit = 0.04;
+  /// does not state the unit; NaN (the default) takes default_velocity_unit(dim).
+  double velocity_unit = std::numeric_limits<double>::quiet_NaN();
   /// Grid spacing = sigma / nodes_per_sigma; 0 picks 6 in 2D and 3 in 3D (memory: the finest
-  /// 3D step of Random3D then needs two grids of about 4.7M nodes; see README for accuracy).
+  /// 3D step of Random3D then has about 2.3M nodes; see README for accuracy).
   double nodes_per_sigma = 0.0;
-  double margin_sigmas = 3.0;    ///< grid margin around the shape, in sigmas (plus 5 std of v)
+  /// Grid margin around the shape, in sigmas, on top of 5 standard deviations of v (the farthest
+  /// a point travels); 0 picks 3 in 2D and 1 in 3D. Only the trajectories of the shape's points
+  /// matter (their domain of dependence under scaling and squaring is the trajectory itself), so
+  /// 5 std plus the interpolation stencil suffice; 3D saves a quarter of its nodes with 1.
+  double margin_sigmas = 0.0;
 };
 
 /// Phi = S o N_K o phi_K o ... o N_1 o phi_1, where each N_k rescales the shape into
@@ -122,9 +131,14 @@ struct SurfaceSamples {
 /// midpoint radially; a triangulated base keeps the flat midpoint.
 enum class BaseKind { sphere, triangulated };
 
-/// Refines `base` (closed surface, outward) by longest-edge splitting, with new pre-image
-/// points placed per `kind`, until every edge of the image under phi is <= `spacing`
-/// (normalised units). Normalises `phi` on the bounding box of the result.
+/// Refines `base` (closed, consistently oriented 2-manifold) until every edge of the image under
+/// phi is <= `spacing` (normalised units), by longest-edge propagation path bisection in the
+/// pre-image (Rivara): an unresolved triangle is refined by bisecting the longest pre-image edge
+/// at the end of its LEPP, new pre-image points placed per `kind`. The pre-image triangles stay
+/// shape-regular, so the refinement ends wherever phi is continuous, also where the image folds
+/// back on itself closer than `spacing`. Normalises `phi` on the bounding box of the result.
+/// Throws std::runtime_error beyond `max_points` points (a draw too wild to resolve) or for a
+/// base that is not a closed, oriented 2-manifold.
 SurfaceSamples sample_surface_image(RandomDeformation& phi, const Boundary& base, BaseKind kind,
                                     double spacing, std::int64_t max_points = 4'000'000);
 
