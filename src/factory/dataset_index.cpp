@@ -6,11 +6,9 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <numeric>
-#include <sstream>
 
 #include "hypershape/config/dataset.hpp"
 #include "hypershape/core/input_error.hpp"
@@ -18,6 +16,7 @@
 #include "hypershape/factory/generate.hpp"
 #include "hypershape/io/dataset_shard.hpp"
 #include "hypershape/io/dataset_xdmf.hpp"
+#include "text_file.hpp"
 
 namespace hypershape::factory {
 
@@ -26,15 +25,7 @@ using nlohmann::json;
 
 namespace {
 
-void write_json(const fs::path& path, const json& j) {
-  const fs::path tmp = path.string() + fmt::format(".tmp-{}", ::getpid());
-  {
-    std::ofstream o(tmp);
-    o << j.dump(1) << "\n";
-    if (!o) throw std::runtime_error("cannot write " + tmp.string());
-  }
-  fs::rename(tmp, path);
-}
+void write_json(const fs::path& path, const json& j) { detail::write_atomically(path, j.dump(1) + "\n"); }
 
 /// Shape ids [0, n) cut into train / val / test by a seeded permutation.
 std::map<std::string, std::vector<std::int64_t>> make_splits(const config::DatasetConfig& c) {
@@ -64,14 +55,7 @@ IndexReport index_dataset(const std::string& dir) {
   if (!fs::exists(yaml)) throw core::InputError(dir, "", "not a dataset directory (no dataset.yaml)");
   const config::DatasetConfig cfg = config::parse_dataset_file(yaml.string());
   // The shards carry the digest of the text generate wrote to dataset.yaml.
-  std::string text;
-  {
-    std::ifstream in(yaml);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    text = ss.str();
-  }
-  const std::string hash = io::text_digest(text);
+  const std::string hash = io::text_digest(detail::read_text(yaml));
   IndexReport rep;
   rep.shards = (cfg.n_shapes + cfg.shard_size - 1) / cfg.shard_size;
 

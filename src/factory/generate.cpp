@@ -9,8 +9,6 @@
 
 #include <chrono>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <thread>
 
 #include "hypershape/core/collective.hpp"
@@ -22,12 +20,16 @@
 #include "hypershape/factory/shape_pipeline.hpp"
 #include "hypershape/io/dataset_shard.hpp"
 #include "hypershape/solver/nonlinear.hpp"
+#include "text_file.hpp"
 
 namespace hypershape::factory {
 
 namespace fs = std::filesystem;
 
 std::string shard_name(std::int64_t k) { return fmt::format("shard-{:06d}.h5", k); }
+
+using detail::read_text;
+using detail::write_atomically;
 
 namespace {
 
@@ -71,23 +73,6 @@ double peak_rss_mib() {
   rusage u{};
   getrusage(RUSAGE_SELF, &u);
   return double(u.ru_maxrss) / 1024.0;
-}
-
-void write_atomically(const fs::path& path, const std::string& text) {
-  const fs::path tmp = path.string() + fmt::format(".tmp-{}", ::getpid());
-  {
-    std::ofstream o(tmp);
-    o << text;
-    if (!o) throw std::runtime_error("cannot write " + tmp.string());
-  }
-  fs::rename(tmp, path);
-}
-
-std::string read_text(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 std::map<std::string, std::string> software_versions() {
@@ -159,6 +144,8 @@ RunReport generate(MPI_Comm comm, const config::DatasetConfig& cfg, const Genera
   rep.shards_total = (cfg.n_shapes + S - 1) / S;
   std::vector<std::int64_t> todo;
   std::int64_t done_before = 0;
+  // The base surface is read (and so checked) before anything is written.
+  const std::optional<geometry::Boundary> base = load_base(cfg.shapes);
   core::on_root(comm, [&] { todo = prepare_output(cfg, opt, rep.shards_total, done_before); });
   {
     std::int64_t n = std::int64_t(todo.size());
@@ -168,7 +155,6 @@ RunReport generate(MPI_Comm comm, const config::DatasetConfig& cfg, const Genera
     MPI_Bcast(&done_before, 1, MPI_INT64_T, 0, comm);
   }
   rep.shards_done_before = done_before;
-  const std::optional<geometry::Boundary> base = load_base(cfg.shapes);
   solver::set_default_options(cfg.petsc);
   HS_PETSC(PetscLogDefaultBegin());
 
