@@ -137,7 +137,8 @@ class Sample:
       grid         dict: sdf, dirichlet_distance, inside (N,)*d (float32, float32, bool);
                    traction, displacement (N,)*d + (d,) float32; numpy 'ij' order, x index first
       alpha, target, max_displacement, min_det_f, traction_normaliser (float)
-      p_n (d,), g (d,) float64; newton_iterations, solves, failed_increments (int)
+      p_n (d,), g (d,) float64; newton_iterations, solves, failed_increments,
+      recovery_iterations (int)
     Arrays belong to the Sample (per-shape arrays are shared by the samples of one shape: do
     not modify them in place).
     """
@@ -156,7 +157,8 @@ class Sample:
 
 # Per-load-case arrays under "loads/" with one row per load case.
 _LOAD_SCALARS = ("alpha", "target", "max_displacement", "min_det_f", "traction_normaliser",
-                 "newton_iterations", "solves", "failed_increments")
+                 "newton_iterations", "solves", "failed_increments", "recovery_iterations")
+_LOAD_COUNTS = ("newton_iterations", "solves", "failed_increments", "recovery_iterations")
 
 
 class Dataset:
@@ -341,7 +343,7 @@ class Dataset:
                   dirichlet_mask=sh.dirichlet_mask, neumann_mask=sh.neumann_mask,
                   displacement=None, point_cloud={}, grid={}, p_n=None, g=None)
         for k in _LOAD_SCALARS:
-            kw[k] = float("nan") if k not in ("newton_iterations", "solves", "failed_increments") else 0
+            kw[k] = 0 if k in _LOAD_COUNTS else float("nan")
         if not sh.ok:
             kw["target"] = float("nan")
             return Sample(**kw)

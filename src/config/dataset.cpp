@@ -132,12 +132,7 @@ void parse_material(const YamlBlock& b, MaterialConfig& m) {
 }
 
 bool flag(const YamlBlock& b, const std::string& key, bool fallback) {
-  if (!b.has(key)) return fallback;
-  try {
-    return b.get(key).as<bool>();
-  } catch (const YAML::Exception&) {
-    b.fail(key, "must be true or false");
-  }
+  return b.has(key) ? b.boolean(key) : fallback;
 }
 
 }  // namespace

@@ -11,7 +11,18 @@ void parse_solver_block(const YamlBlock& sol, solver::SolverOptions& s) {
   if (s.max_increments < 1) sol.fail("max_increments", "must be >= 1");
   if (sol.has("target_rtol")) s.target_rtol = sol.number("target_rtol");
   if (!(s.target_rtol > 0 && s.target_rtol < 1)) sol.fail("target_rtol", "must be in (0, 1)");
-  sol.allowed("rtol, max_newton, max_increments, target_rtol");
+  if (sol.has("control")) {
+    const std::string c = sol.text("control");
+    if (c == "displacement") s.control = solver::Control::displacement;
+    else if (c == "load") s.control = solver::Control::load;
+    else sol.fail("control", "must be displacement or load");
+  }
+  if (sol.has("path_rtol")) s.path_rtol = sol.number("path_rtol");
+  if (!(s.path_rtol > 0 && s.path_rtol < 1)) sol.fail("path_rtol", "must be in (0, 1)");
+  if (sol.has("newton_budget")) s.newton_budget = int(sol.integer("newton_budget"));
+  if (s.newton_budget < 1) sol.fail("newton_budget", "must be >= 1");
+  if (sol.has("fallback")) s.fallback = sol.boolean("fallback");
+  sol.allowed("rtol, max_newton, max_increments, target_rtol, control, path_rtol, newton_budget, fallback");
   sol.check_all_used();
 }
 

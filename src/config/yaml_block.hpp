@@ -63,6 +63,15 @@ class YamlBlock {
     if (v != std::floor(v)) fail(key, "must be an integer");
     return long(v);
   }
+  bool boolean(const std::string& key) const {
+    auto n = get(key);
+    if (!n || n.IsNull()) fail(key, "missing (true or false is required)");
+    try {
+      return n.as<bool>();
+    } catch (const YAML::Exception&) {
+      fail(key, "must be true or false");
+    }
+  }
   std::string text(const std::string& key) const {
     auto n = get(key);
     if (!n || n.IsNull()) fail(key, "missing (a string is required)");

@@ -236,6 +236,7 @@ RunReport generate(MPI_Comm comm, const config::DatasetConfig& cfg, const Genera
         rep.newton_iterations += r.newton_iterations;
         rep.solves += r.solves;
         rep.failed_increments += r.failed_increments;
+        rep.recovery_iterations += r.recovery_iterations;
         if (!r.entry.ok)
           core::log_line(MPI_COMM_SELF, core::Verbosity::normal,
                          fmt::format("[generate] shape {} failed: {}", id, r.entry.failure.substr(0, 300)));
@@ -280,6 +281,7 @@ RunReport generate(MPI_Comm comm, const config::DatasetConfig& cfg, const Genera
   rep.newton_iterations = sum_roots(rep.newton_iterations);
   rep.solves = sum_roots(rep.solves);
   rep.failed_increments = sum_roots(rep.failed_increments);
+  rep.recovery_iterations = sum_roots(rep.recovery_iterations);
   rep.shards_written = sum_roots(shards_written);
   const std::vector<std::string> phases = {"shape", "mesh", "setup", "solve", "alpha_search",
                                            "representations", "gather", "io"};
@@ -314,7 +316,8 @@ RunReport generate(MPI_Comm comm, const config::DatasetConfig& cfg, const Genera
       j["load_cases"] = {{"converged", rep.loads_ok}, {"failed", rep.loads_failed},
                          {"per_second", (rep.loads_ok + rep.loads_failed) / std::max(1e-9, rep.seconds)}};
       j["solver"] = {{"newton_iterations", rep.newton_iterations}, {"nonlinear_solves", rep.solves},
-                     {"failed_increments", rep.failed_increments}};
+                     {"failed_increments", rep.failed_increments},
+                     {"recovery_iterations", rep.recovery_iterations}};
       j["seconds"] = {{"wall", rep.seconds}, {"phases_summed_over_groups", rep.phase_seconds},
                       {"factorization_PCSetUp_summed_over_ranks", rep.factorization_seconds}};
       j["peak_rss_mib_per_rank"] = rss;
@@ -342,8 +345,9 @@ std::string report_table(const RunReport& r) {
   const double loads = double(r.loads_ok + r.loads_failed);
   s += fmt::format("  shapes {} ({} failed), load cases {} converged, {} failed, in {:.1f} s: {:.2f} load cases/s\n",
                    r.shapes, r.shapes_failed, r.loads_ok, r.loads_failed, r.seconds, loads / std::max(1e-9, r.seconds));
-  s += fmt::format("  Newton iterations {} in {} nonlinear solves ({:.1f} per load case), {} failed increments\n",
-                   r.newton_iterations, r.solves, r.newton_iterations / std::max(1.0, loads), r.failed_increments);
+  s += fmt::format("  Newton iterations {} in {} increments ({:.1f} per load case); {} failed increments "
+                   "cost {} of them\n", r.newton_iterations, r.solves, r.newton_iterations / std::max(1.0, loads),
+                   r.failed_increments, r.recovery_iterations);
   double total = 0;
   for (const auto& [k, v] : r.phase_seconds) total += v;
   s += "  phase              seconds   share\n";

@@ -222,7 +222,7 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
       min_det(std::size_t(n_loads), 0), normaliser(std::size_t(n_loads), 0), p_n(std::size_t(n_loads * d)),
       g(std::size_t(n_loads * d));
   std::vector<std::int64_t> newton(std::size_t(n_loads), 0), solves(std::size_t(n_loads), 0),
-      failed_inc(std::size_t(n_loads), 0);
+      failed_inc(std::size_t(n_loads), 0), recovery(std::size_t(n_loads), 0);
   std::vector<double> displacement, node_traction;
   std::vector<float> grid_u, grid_t;
   if (root) {
@@ -261,6 +261,8 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
     newton[L] = r.newton_iterations;
     solves[L] = r.solves;
     failed_inc[L] = r.failed_increments;
+    recovery[L] = r.recovery_iterations;
+    out.recovery_iterations += r.recovery_iterations;
     out.newton_iterations += r.newton_iterations;
     out.solves += r.solves;
     out.failed_increments += r.failed_increments;
@@ -328,6 +330,8 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
     arrays.push_back({"loads/newton_iterations", {nl_}, newton, "Newton iterations, all solves of the alpha search", ""});
     arrays.push_back({"loads/solves", {nl_}, solves, "nonlinear solves (alpha evaluations)", ""});
     arrays.push_back({"loads/failed_increments", {nl_}, failed_inc, "load increments that failed and were halved", ""});
+    arrays.push_back({"loads/recovery_iterations", {nl_}, recovery,
+                      "Newton iterations spent in failed (discarded) increments: the cost of recovery", ""});
     arrays.push_back({"loads/p_n", {nl_, du}, p_n, "traction centre p_N (on the Neumann boundary)", "length"});
     arrays.push_back({"loads/g", {nl_, du}, g, "traction direction g (unit vector)", ""});
     arrays.push_back({"loads/displacement", {nl_, U64(n_nodes), du}, std::move(displacement),

@@ -1,9 +1,11 @@
 #include "hypershape/solver/nonlinear.hpp"
 
 #include "hypershape/core/timer.hpp"
+#include <petscmat.h>
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <vector>
 
 #include "hypershape/core/error.hpp"
@@ -43,6 +45,7 @@ NonlinearSolver::NonlinearSolver(const physics::Problem& problem, const SolverOp
   u_ = problem.create_vector();
   backup_ = problem.create_vector();
   r_ = problem.create_vector();
+  for (core::VecH* v : {&a_, &a0_, &b_, &c_, &du_, &w_}) *v = problem.create_vector();
   HS_PETSC(SNESCreate(comm, snes_.out()));
   if (!prefix.empty()) HS_PETSC(SNESSetOptionsPrefix(snes_, prefix.c_str()));
   // No SNESSetDM: SNES callbacks live on the DM's DMSNES, so solvers sharing the problem's DM
@@ -108,38 +111,44 @@ PetscErrorCode NonlinearSolver::guarded_line_search(SNESLineSearch ls, void* ctx
 }
 
 void NonlinearSolver::line_search(SNESLineSearch ls) {
+  Vec X, F, Y, W, G;
+  HS_PETSC(SNESLineSearchGetVecs(ls, &X, &F, &Y, &W, &G));
+  const double lambda = backtrack(X, Y, F, s_eval_, W, G);
+  if (lambda == 0.0) {
+    HS_PETSC(SNESLineSearchSetReason(ls, SNES_LINESEARCH_FAILED_REDUCT));
+    return;
+  }
+  HS_PETSC(VecCopy(W, X));
+  HS_PETSC(VecCopy(G, F));
+  HS_PETSC(SNESLineSearchSetLambda(ls, lambda));
+  HS_PETSC(SNESLineSearchComputeNorms(ls));
+  HS_PETSC(SNESLineSearchSetReason(ls, SNES_LINESEARCH_SUCCEEDED));
+}
+
+double NonlinearSolver::backtrack(Vec X, Vec Y, Vec F, double s, Vec W, Vec G) {
   // Newton step: W = X - lambda Y. Backtrack from lambda = 1 until W is admissible (det F > 0
   // everywhere: finite energy) and either the energy decreases (Armijo) or, where the tangent
   // is not positive definite or the energy change is below round-off, the residual norm does.
-  Vec X, F, Y, W, G;
-  HS_PETSC(SNESLineSearchGetVecs(ls, &X, &F, &Y, &W, &G));
   PetscReal fnorm0, slope;
   HS_PETSC(VecNorm(F, NORM_2, &fnorm0));
   HS_PETSC(VecDot(F, Y, &slope));
   slope = -slope;  // d/dlambda of the energy at lambda = 0
   double e0;
-  problem_.energy(X, s_eval_, e0);
+  problem_.energy(X, s, e0);
   constexpr double c = 1e-4;
   double lambda = 1.0;
-  bool accepted = false;
   for (int it = 0; it < 40 && lambda > 1e-10; ++it) {
     HS_PETSC(VecWAXPY(W, -lambda, Y, X));
     double e;
-    if (!problem_.energy(W, s_eval_, e)) {  // inadmissible: never accept, halve
+    if (!problem_.energy(W, s, e)) {  // inadmissible: never accept, halve
       lambda *= 0.5;
       continue;
     }
-    if (slope < 0 && e <= e0 + c * lambda * slope) {
-      accepted = true;
-      break;
-    }
-    const bool ok = problem_.residual(W, s_eval_, G);
+    const bool ok = problem_.residual(W, s, G);
+    if (ok && slope < 0 && e <= e0 + c * lambda * slope) return lambda;
     PetscReal gnorm;
     HS_PETSC(VecNorm(G, NORM_2, &gnorm));
-    if (ok && gnorm <= (1.0 - c * lambda) * fnorm0) {
-      accepted = true;
-      break;
-    }
+    if (ok && gnorm <= (1.0 - c * lambda) * fnorm0) return lambda;
     if (slope < 0 && std::isfinite(e)) {  // quadratic model of the energy along the step
       const double denom = 2.0 * (e - e0 - slope * lambda);
       const double l = denom > 0 ? -slope * lambda * lambda / denom : 0.5 * lambda;
@@ -148,19 +157,7 @@ void NonlinearSolver::line_search(SNESLineSearch ls) {
       lambda *= 0.5;
     }
   }
-  if (!accepted) {
-    HS_PETSC(SNESLineSearchSetReason(ls, SNES_LINESEARCH_FAILED_REDUCT));
-    return;
-  }
-  if (!problem_.residual(W, s_eval_, G)) {
-    HS_PETSC(SNESLineSearchSetReason(ls, SNES_LINESEARCH_FAILED_DOMAIN));
-    return;
-  }
-  HS_PETSC(VecCopy(W, X));
-  HS_PETSC(VecCopy(G, F));
-  HS_PETSC(SNESLineSearchSetLambda(ls, lambda));
-  HS_PETSC(SNESLineSearchComputeNorms(ls));
-  HS_PETSC(SNESLineSearchSetReason(ls, SNES_LINESEARCH_SUCCEEDED));
+  return 0.0;
 }
 
 bool NonlinearSolver::newton(double s, SolveResult& r) {
@@ -208,6 +205,10 @@ SolveResult NonlinearSolver::solve(double target) {
   const double min_step = std::abs(total) * opt_.min_increment;
   int attempts = 0;
   while (s_ != target) {
+    if (r.newton_iterations >= opt_.newton_budget) {
+      r.reason = "Newton budget of " + std::to_string(opt_.newton_budget) + " iterations spent";
+      break;
+    }
     if (++attempts > opt_.max_increments) {
       r.reason = "too many load increments (last: " + r.reason + ")";
       break;
@@ -249,9 +250,257 @@ double NonlinearSolver::linear_response() {
 
 TargetResult NonlinearSolver::solve_for_target(double target) {
   const double start = core::now_seconds();
-  TargetResult t = search_target(target, start);
+  TargetResult t = opt_.control == Control::displacement ? follow_path(target, start)
+                                                          : search_target(target, start);
+  if (opt_.control == Control::displacement && !t.converged && opt_.fallback && target > 0) {
+    // Fallback, measured on Random2D draws: where the path cannot be followed (Newton stalls
+    // next to a bifurcation), load-controlled solves from the last converged state of the
+    // path may still reach a stable equilibrium at the target (a buckled one).
+    const TargetResult path = t;
+    t = search_target(target, start);
+    t.solves += path.solves;
+    t.newton_iterations += path.newton_iterations;
+    t.failed_increments += path.failed_increments;
+    t.increments += path.increments;
+    t.recovery_iterations += path.newton_iterations;
+    t.reason = (t.converged ? "target reached by load control" : t.reason) +
+               " (displacement control: " + path.reason + ")";
+  }
   t.seconds_total = core::now_seconds() - start;
   if (t.solves <= 1) t.seconds_first_solve = t.seconds_total;
+  return t;
+}
+
+bool NonlinearSolver::tangent_response() {
+  negative_pivots_ = -1;
+  if (!problem_.jacobian(u_, J_)) return false;
+  KSP ksp;
+  HS_PETSC(SNESGetKSP(snes_, &ksp));
+  HS_PETSC(KSPSetOperators(ksp, J_, J_));
+  HS_PETSC(KSPSolve(ksp, problem_.load(), a_));
+  KSPConvergedReason kr;
+  HS_PETSC(KSPGetConvergedReason(ksp, &kr));
+  // Inertia from MUMPS's symmetric factorisation: by Sylvester's law, the number of negative
+  // pivots is the number of negative eigenvalues of the tangent (INFOG(12)).
+  PC pc;
+  PCType type;
+  MatSolverType package;
+  HS_PETSC(KSPGetPC(ksp, &pc));
+  HS_PETSC(PCGetType(pc, &type));
+  if (kr > 0 && type && std::string(type) == PCCHOLESKY) {
+    HS_PETSC(PCFactorGetMatSolverType(pc, &package));
+    if (package && std::string(package) == MATSOLVERMUMPS) {
+      Mat F;
+      PetscInt neg;
+      HS_PETSC(PCFactorGetMatrix(pc, &F));
+      HS_PETSC(MatMumpsGetInfog(F, 12, &neg));
+      negative_pivots_ = int(neg);
+    }
+  }
+  return kr > 0;
+}
+
+double NonlinearSolver::control_direction(Vec u, Vec fallback, Vec c) {
+  DM dm = problem_.dm();
+  const int dim = problem_.space().dim();
+  const MPI_Comm comm = problem_.comm();
+  Vec ul, cl;
+  HS_PETSC(DMGetLocalVector(dm, &ul));
+  HS_PETSC(DMGetLocalVector(dm, &cl));
+  // The node of the largest |v| (ties: the smallest canonical index, on any rank count).
+  auto largest = [&](Vec v, PetscInt& offset, double& norm2) {
+    HS_PETSC(VecSet(ul, 0.0));
+    HS_PETSC(DMGlobalToLocal(dm, v, INSERT_VALUES, ul));
+    const PetscScalar* a;
+    HS_PETSC(VecGetArrayRead(ul, &a));
+    double best = -1;
+    std::int64_t id = INT64_MAX;
+    offset = -1;
+    for (const auto& n : problem_.space().owned_nodes()) {
+      double s = 0;
+      for (int i = 0; i < dim; ++i) s += a[n.offset + i] * a[n.offset + i];
+      if (s > best || (s == best && n.canonical < id)) best = s, id = n.canonical, offset = n.offset;
+    }
+    HS_PETSC(VecRestoreArrayRead(ul, &a));
+    double gbest = best;
+    MPI_Allreduce(MPI_IN_PLACE, &gbest, 1, MPI_DOUBLE, MPI_MAX, comm);
+    std::int64_t gid = best == gbest ? id : INT64_MAX;
+    MPI_Allreduce(MPI_IN_PLACE, &gid, 1, MPI_INT64_T, MPI_MIN, comm);
+    if (!(best == gbest && id == gid)) offset = -1;  // another rank owns the node
+    norm2 = gbest;
+  };
+  PetscInt off;
+  double m2;
+  largest(u, off, m2);
+  if (m2 <= 0.0) largest(fallback, off, m2);  // u = 0: the node that will move most
+  const double m = std::sqrt(std::max(m2, 0.0));
+  HS_PETSC(VecSet(cl, 0.0));
+  if (off >= 0 && m > 0) {  // ul still holds the vector the node was picked from
+    const PetscScalar* a;
+    PetscScalar* cv;
+    HS_PETSC(VecGetArrayRead(ul, &a));
+    HS_PETSC(VecGetArray(cl, &cv));
+    for (int i = 0; i < dim; ++i) cv[off + i] = a[off + i] / m;
+    HS_PETSC(VecRestoreArray(cl, &cv));
+    HS_PETSC(VecRestoreArrayRead(ul, &a));
+  }
+  HS_PETSC(DMLocalToGlobal(dm, cl, INSERT_VALUES, c));  // owned entries only
+  HS_PETSC(DMRestoreLocalVector(dm, &cl));
+  HS_PETSC(DMRestoreLocalVector(dm, &ul));
+  PetscReal cu;
+  HS_PETSC(VecDot(c, u, &cu));
+  return cu;  // = max|u| (0 when u = 0)
+}
+
+bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why) {
+  KSP ksp;
+  HS_PETSC(SNESGetKSP(snes_, &ksp));
+  const double fnorm = problem_.load_norm();
+  const double gtol = 0.1 * opt_.target_rtol * std::abs(d);
+  if (!problem_.residual(u_, s_, r_)) {
+    why = "inadmissible state (det F <= 0)";
+    return false;
+  }
+  PetscReal rn, rn0;
+  HS_PETSC(VecNorm(r_, NORM_2, &rn));
+  rn0 = rn;
+  for (int k = 0;; ++k) {
+    const double m = control_direction(u_, a_, c_);
+    const double g = m - d;
+    if (!std::isfinite(rn)) {
+      why = "non-finite residual";
+      return false;
+    }
+    if (rn <= opt_.atol + rtol * std::abs(s_) * fnorm && std::abs(g) <= gtol) return true;
+    if (k == opt_.max_newton) {
+      why = "no convergence in " + std::to_string(opt_.max_newton) + " Newton iterations";
+      return false;
+    }
+    if (k >= 4 && rn > rn0) {  // quadratic convergence would be far along by now
+      why = "no progress in " + std::to_string(k) + " Newton iterations";
+      return false;
+    }
+    if (its >= opt_.newton_budget) {
+      why = "Newton budget of " + std::to_string(opt_.newton_budget) + " iterations spent";
+      return false;
+    }
+    ++its;
+    if (!tangent_response()) {
+      why = "tangent factorisation or solve failed";
+      return false;
+    }
+    // Bordered system: K du - dalpha f = -R, c . du = d - m, with K^-1 f = a and K^-1 R = b.
+    HS_PETSC(KSPSolve(ksp, r_, b_));
+    PetscReal ca, cb;
+    HS_PETSC(VecDot(c_, a_, &ca));
+    HS_PETSC(VecDot(c_, b_, &cb));
+    if (!(std::abs(ca) > 0) || !std::isfinite(ca)) {
+      why = "singular bordered system";
+      return false;
+    }
+    const double dalpha = (d - m + cb) / ca;
+    // du is Newton's step for equilibrium at the load s + dalpha: take it with the guarded
+    // energy line search at that load, and the same fraction of dalpha.
+    const double s_full = s_ + dalpha;
+    HS_PETSC(VecAXPBYPCZ(du_, 1.0, -dalpha, 0.0, b_, a_));  // Y = -du = b - dalpha a
+    HS_PETSC(VecAXPY(r_, -dalpha, problem_.load()));       // R(u, s + dalpha)
+    const double lambda = backtrack(u_, du_, r_, s_full, w_, b_);
+    if (lambda == 0.0) {
+      why = "line search found no admissible decrease";
+      return false;
+    }
+    HS_PETSC(VecCopy(w_, u_));
+    s_ += lambda * dalpha;
+    HS_PETSC(VecWAXPY(r_, (1.0 - lambda) * dalpha, problem_.load(), b_));  // R(w, s_)
+    HS_PETSC(VecNorm(r_, NORM_2, &rn));
+  }
+}
+
+TargetResult NonlinearSolver::follow_path(double target, double start) {
+  TargetResult t;
+  if (!(target > 0) || !std::isfinite(target)) {
+    t.reason = "target max|u| must be positive";
+    return t;
+  }
+  if (!tangent_response()) {
+    t.reason = "tangent factorisation or solve failed at the start";
+    return t;
+  }
+  double d = problem_.max_displacement(u_);
+  double step = target - d;
+  const double min_step = std::abs(step) * opt_.min_increment;
+  int its = 0;
+  std::string why;
+  while (true) {
+    const bool last = std::abs(target - d) <= std::abs(step) * (1 + 1e-12);
+    const double d_next = last ? target : d + step;
+    HS_PETSC(VecCopy(u_, backup_));
+    HS_PETSC(VecCopy(a_, a0_));
+    const double s_backup = s_;
+    const int its_before = its;
+    ++t.solves;
+    // Tangent predictor to c . u = d_next: from an equilibrium at s, dalpha a is Newton's step
+    // at the load s + dalpha. Taken with the guarded energy line search: never an inverted
+    // state, and damped where a linearised large rotation would stretch a nearly
+    // incompressible body. (Shortening the increment to the damped length instead cost more
+    // increments than it saved: measured on Random2D draws.)
+    const double m = control_direction(u_, a_, c_);
+    PetscReal ca;
+    HS_PETSC(VecDot(c_, a_, &ca));
+    bool ok = ca > 0;
+    if (!ok) why = "limit point: max|u| does not grow with the load";
+    if (ok) {
+      const double dalpha = (d_next - m) / ca;
+      const double s_pred = s_backup + dalpha;
+      if (!problem_.residual(u_, s_pred, r_)) throw std::logic_error("a converged state is inadmissible");
+      HS_PETSC(VecAXPBY(du_, -dalpha, 0.0, a_));  // Y = -dalpha a
+      const double lambda = backtrack(backup_, du_, r_, s_pred, w_, b_);
+      if (lambda > 0.0) {
+        HS_PETSC(VecCopy(w_, u_));
+        s_ = s_backup + lambda * dalpha;
+      }
+      ok = correct(d_next, last ? opt_.rtol : opt_.path_rtol, its, why);
+    }
+    if (t.solves == 1) t.seconds_first_solve = core::now_seconds() - start;
+    if (ok && negative_pivots_ > 0) {
+      // An equilibrium whose tangent is indefinite: the path has passed a bifurcation (the
+      // body buckles); the states beyond are not the ones a load brings the body to.
+      t.reason = "loss of stability at max|u| = " + std::to_string(d_next) + ", alpha = " +
+                 std::to_string(s_) + ": the tangent has " + std::to_string(negative_pivots_) +
+                 " negative eigenvalue(s) (buckling or a bifurcation)";
+      ++t.increments;
+      d = d_next;
+      break;
+    }
+    if (ok) {
+      ++t.increments;
+      d = d_next;
+      if (last) break;
+      const int n = its - its_before;
+      if (n <= 3) step *= 2.0; else if (n >= 8) step *= 0.5;
+      continue;
+    }
+    HS_PETSC(VecCopy(backup_, u_));
+    HS_PETSC(VecCopy(a0_, a_));
+    s_ = s_backup;
+    ++t.failed_increments;
+    t.recovery_iterations += its - its_before;
+    step *= 0.5;
+    if (its >= opt_.newton_budget) {
+      t.reason = why;
+      break;
+    }
+    if (std::abs(step) < min_step || t.solves >= opt_.max_increments) {
+      t.reason = "increment below minimum or too many increments (last: " + why + ")";
+      break;
+    }
+  }
+  t.newton_iterations = its;
+  t.max_displacement = problem_.max_displacement(u_);
+  t.alpha = s_;
+  t.negative_pivots = negative_pivots_;
+  t.converged = d == target && !(negative_pivots_ > 0);
+  if (t.converged) t.reason = "target reached";
   return t;
 }
 
@@ -279,6 +528,10 @@ TargetResult NonlinearSolver::search_target(double target, double start) {
   double lo = 0, hi = INFINITY;  // bracket in alpha: m(lo) < target < m(hi)
   std::vector<std::pair<double, double>> hist;  // (log alpha, log m)
   for (int k = 0; k < opt_.max_target_solves; ++k) {
+    if (t.newton_iterations >= opt_.newton_budget) {
+      t.reason = "Newton budget of " + std::to_string(opt_.newton_budget) + " iterations spent";
+      return t;
+    }
     SolveResult r = solve(alpha);
     account(r);
     if (!r.converged) {

@@ -198,3 +198,60 @@ TEST_CASE("Continuing from a converged state reaches the same equilibrium", "[so
   REQUIRE(back.converged);
   CHECK(back.max_displacement < 1e-8);
 }
+
+TEST_CASE("Displacement control and load control find the same equilibrium", "[solver]") {
+  DiskScene scene;
+  auto& p = scene.problem;
+  for (double target : {0.3, 0.8}) {
+    solver::NonlinearSolver path(p);
+    const auto a = path.solve_for_target(target);
+    solver::SolverOptions lo;
+    lo.control = solver::Control::load;
+    solver::NonlinearSolver search(p, lo);
+    const auto b = search.solve_for_target(target);
+    INFO("target " << target << ": path " << a.reason << " (" << a.newton_iterations
+                   << " its, " << a.increments << " increments, " << a.failed_increments
+                   << " failed), load control " << b.reason << " (" << b.newton_iterations << " its)");
+    REQUIRE(a.converged);
+    REQUIRE(b.converged);
+    CHECK(std::abs(a.max_displacement / target - 1) <= 1e-3);
+    // Both hit max|u| within target_rtol = 1e-3; alpha agrees to the same order.
+    CHECK(a.alpha == Approx(b.alpha).epsilon(3e-3));
+    // The accepted state is a stable equilibrium: MUMPS LDL^T reports no negative pivot.
+    CHECK(a.negative_pivots == 0);
+    CHECK(p.min_det_f(path.solution()) > 0);
+  }
+}
+
+TEST_CASE("Failed increments are recovered and their cost counted; a spent budget is a recorded failure", "[solver]") {
+  DiskScene scene;
+  auto& p = scene.problem;
+  SECTION("two Newton iterations per increment: the path halves until it gets through") {
+    solver::SolverOptions o;
+    o.max_newton = 2;
+    o.path_rtol = 0.5;  // two iterations cannot meet 1e-2 far from u = 0
+    solver::NonlinearSolver ns(p, o);
+    const auto t = ns.solve_for_target(0.6);
+    INFO(t.reason << ": " << t.newton_iterations << " its, " << t.increments << " increments, "
+                  << t.failed_increments << " failed costing " << t.recovery_iterations);
+    REQUIRE(t.failed_increments > 0);
+    CHECK(t.recovery_iterations >= t.failed_increments);
+    CHECK(t.recovery_iterations < t.newton_iterations);
+    if (t.converged) CHECK(std::abs(t.max_displacement / 0.6 - 1) <= 1e-3);
+    CHECK(p.min_det_f(ns.solution()) > 0);
+    CHECK(all_finite(values(ns.solution())));
+  }
+  SECTION("a budget of 3 Newton iterations cannot reach max|u| = 1") {
+    solver::SolverOptions o;
+    o.newton_budget = 3;
+    solver::NonlinearSolver ns(p, o);
+    const auto t = ns.solve_for_target(1.0);
+    INFO(t.reason);
+    CHECK_FALSE(t.converged);
+    CHECK_THAT(t.reason, Catch::Contains("budget"));
+    CHECK(t.newton_iterations <= 3);
+    // The state is the last converged one: admissible and finite.
+    CHECK(p.min_det_f(ns.solution()) > 0);
+    CHECK(all_finite(values(ns.solution())));
+  }
+}

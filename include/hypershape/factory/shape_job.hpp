@@ -19,7 +19,7 @@ namespace hypershape::factory {
 struct ShapeJobResult {
   io::ShardShape entry;      ///< significant on rank 0 of the group
   int loads_ok = 0, loads_failed = 0;
-  int newton_iterations = 0, solves = 0, failed_increments = 0;
+  int newton_iterations = 0, solves = 0, failed_increments = 0, recovery_iterations = 0;
   std::int64_t n_dofs = 0;
   /// shape (draw + boundary + checks), mesh, setup, solve (first nonlinear solve of each load
   /// case), alpha_search (the further solves), representations, gather.
