@@ -32,6 +32,7 @@ import argparse
 import json
 import math
 import os
+import re
 import sys
 import zlib
 from collections import OrderedDict
@@ -667,13 +668,75 @@ def check_dataset(path, out=sys.stdout):
     return problems
 
 
+def solver_report(path):
+    """Solver outcomes of a dataset: load cases converged, failures grouped by reason, Newton
+    iterations per load case and the cost of recovery (iterations spent in failed increments).
+    Returns a dict (JSON-ready)."""
+    ds = open_dataset(path)
+    its, rec, inc, fails, status = [], [], [], {}, []
+    for sid in ds.shape_ids(include_failed=True):
+        sh = ds.shape(sid)
+        if not sh.ok:
+            for r in sh.reasons:
+                status.append(0)
+                key = re.sub(r"[-+]?\d+(\.\d+)?(e[-+]?\d+)?", "#", r)
+                fails[key] = fails.get(key, 0) + 1
+            continue
+        g = ds._group(sid)["loads"]
+        its += list(g["newton_iterations"][...])
+        rec += list(g["recovery_iterations"][...]) if "recovery_iterations" in g else [0] * len(sh.reasons)
+        inc += list(g["solves"][...])
+        for k, r in enumerate(sh.reasons):
+            status.append(int(sh.status[k]))
+            if not sh.status[k]:
+                key = re.sub(r"[-+]?\d+(\.\d+)?(e[-+]?\d+)?", "#", r)  # numbers out: group by kind
+                fails[key] = fails.get(key, 0) + 1
+    ds.close()
+    its, rec, status = np.array(its, float), np.array(rec, float), np.array(status)
+    n = len(status)
+    pct = lambda q: float(np.percentile(its, q)) if len(its) else 0.0  # noqa: E731
+    return {"dataset": path, "load_cases": n, "converged": int(status.sum()),
+            "converged_percent": 100.0 * status.sum() / max(n, 1),
+            "failures_by_reason": dict(sorted(fails.items(), key=lambda kv: -kv[1])),
+            "newton_iterations": {"total": int(its.sum()), "mean": float(its.mean()) if len(its) else 0.0,
+                                  "median": pct(50), "p90": pct(90), "p99": pct(99),
+                                  "max": float(its.max()) if len(its) else 0.0},
+            "increments_per_load_case_mean": float(np.mean(inc)) if inc else 0.0,
+            "recovery_iterations": {"total": int(rec.sum()),
+                                    "share_of_newton_iterations": float(rec.sum() / max(its.sum(), 1)),
+                                    "load_cases_with_recovery": int((rec > 0).sum())}}
+
+
+def print_solver_report(r, out=sys.stdout):
+    w = lambda s: print(s, file=out)  # noqa: E731
+    it, rc = r["newton_iterations"], r["recovery_iterations"]
+    w(f"{r['dataset']}: {r['converged']}/{r['load_cases']} load cases converged ({r['converged_percent']:.2f}%)")
+    w(f"  Newton iterations per load case: mean {it['mean']:.1f}, median {it['median']:.0f}, "
+      f"p90 {it['p90']:.0f}, p99 {it['p99']:.0f}, max {it['max']:.0f}; "
+      f"{r['increments_per_load_case_mean']:.1f} increments per load case")
+    w(f"  recovery (iterations in failed increments): {rc['total']} = {100 * rc['share_of_newton_iterations']:.1f}% "
+      f"of all, in {rc['load_cases_with_recovery']} load cases")
+    for reason, k in r["failures_by_reason"].items():
+        w(f"  failed {k:>5} x  {reason}")
+
+
 def _main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = ap.add_subparsers(dest="command", required=True)
     sub.add_parser("summary", help="counts, splits, statistics, array shapes").add_argument("dir")
     sub.add_parser("check", help="CRC-32 against manifest.json, no NaN/Inf; exit 1 otherwise").add_argument("dir")
+    sp = sub.add_parser("solver", help="convergence rate, failure reasons, Newton and recovery cost")
+    sp.add_argument("dir")
+    sp.add_argument("--json", help="also write the figures here")
     a = ap.parse_args(argv)
+    if a.command == "solver":
+        r = solver_report(a.dir)
+        print_solver_report(r)
+        if a.json:
+            with open(a.json, "w") as f:
+                json.dump(r, f, indent=1)
+        return 0
     if a.command == "summary":
         try:
             return summary(a.dir)

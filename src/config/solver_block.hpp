@@ -9,7 +9,8 @@
 
 namespace hypershape::config {
 
-/// Reads rtol, max_newton, max_increments, target_rtol over the defaults in `out`.
+/// Reads rtol, max_newton, max_increments, target_rtol, control (displacement | load),
+/// path_rtol, newton_budget, fallback over the defaults in `out`.
 void parse_solver_block(const YamlBlock& block, solver::SolverOptions& out);
 /// Reads any PETSc options (key without the dash: scalar value or empty).
 void parse_petsc_block(const YamlBlock& block, std::vector<std::pair<std::string, std::string>>& out);

@@ -46,6 +46,33 @@ class LocalArray {
   bool write_;
 };
 
+/// Coordinates of the node carried by local point p: a vertex, or the midpoint of an edge (P2).
+std::array<double, 3> node_position(DM dm, PetscSection cs, const PetscScalar* xa, PetscInt p,
+                                    int dim) {
+  auto vertex = [&](PetscInt v) {
+    PetscInt off;
+    HS_PETSC(PetscSectionGetOffset(cs, v, &off));
+    std::array<double, 3> x{};
+    for (int k = 0; k < dim; ++k) x[k] = PetscRealPart(xa[off + k]);
+    return x;
+  };
+  PetscInt depth;
+  HS_PETSC(DMPlexGetPointDepth(dm, p, &depth));
+  if (depth == 0) return vertex(p);
+  const PetscInt* cone;
+  HS_PETSC(DMPlexGetCone(dm, p, &cone));
+  auto a = vertex(cone[0]), b = vertex(cone[1]);
+  for (int k = 0; k < 3; ++k) a[k] = 0.5 * (a[k] + b[k]);
+  return a;
+}
+
+/// m += x × f (3-vectors; 2D vectors have a zero third component).
+void add_moment(const double* x, const double* f, std::array<double, 3>& m) {
+  m[0] += x[1] * f[2] - x[2] * f[1];
+  m[1] += x[2] * f[0] - x[0] * f[2];
+  m[2] += x[0] * f[1] - x[1] * f[0];
+}
+
 bool all_ranks(MPI_Comm comm, bool ok) {
   int v = ok ? 1 : 0;
   MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_INT, MPI_MIN, comm);
@@ -165,6 +192,62 @@ void Problem::jacobian_pointwise(Vec u, Mat J) const {
   LocalArray ul(dm(), false);
   to_local(u, ul.vec());
   HS_PETSC(DMPlexSNESComputeJacobianFEM(dm(), ul.vec(), J, J, nullptr));
+}
+
+Resultants Problem::resultants(Vec u, double load_factor) const {
+  const int dim = space_->dim();
+  LocalArray ul(dm(), false), fi(dm(), true), fe(dm(), true);
+  to_local(u, ul.vec());
+  bool ok = true;
+  for (auto& eff : effects_) {
+    if (eff->has_energy()) ok = ok && eff->add_residual(*space_, ul.array(), fi.array());
+    if (eff->has_load()) eff->add_load(*space_, fe.array());
+  }
+  Resultants out;
+  out.admissible = all_ranks(comm(), ok);
+  // Nothing is scattered: every cell and every Neumann facet is on exactly one rank, so the sum
+  // of all local entries (ghosts included) over the ranks counts each contribution once, and the
+  // constrained entries, which the global layout drops, are still there.
+  PetscSection ls, cs;
+  Vec coords;
+  const PetscScalar* xa;
+  HS_PETSC(DMGetLocalSection(dm(), &ls));
+  HS_PETSC(DMGetCoordinateSection(dm(), &cs));
+  HS_PETSC(DMGetCoordinatesLocal(dm(), &coords));
+  HS_PETSC(VecGetArrayRead(coords, &xa));
+  const PetscScalar *a = ul.array(), *f_int = fi.array(), *f_ext = fe.array();
+  PetscInt p0, p1;
+  HS_PETSC(PetscSectionGetChart(ls, &p0, &p1));
+  for (PetscInt p = p0; p < p1; ++p) {
+    PetscInt n_dof, off, n_con;
+    HS_PETSC(PetscSectionGetDof(ls, p, &n_dof));
+    if (n_dof == 0) continue;
+    HS_PETSC(PetscSectionGetOffset(ls, p, &off));
+    HS_PETSC(PetscSectionGetConstraintDof(ls, p, &n_con));
+    const std::array<double, 3> x = node_position(dm(), cs, xa, p, dim);
+    double y[3] = {0, 0, 0}, load[3] = {0, 0, 0}, support[3] = {0, 0, 0};
+    for (int i = 0; i < dim; ++i) {
+      y[i] = x[i] + PetscRealPart(a[off + i]);
+      load[i] = load_factor * PetscRealPart(f_ext[off + i]);
+      out.applied_force[i] += load[i];
+    }
+    add_moment(y, load, out.applied_moment);
+    add_moment(x.data(), load, out.applied_moment_reference);
+    if (n_con == 0) continue;
+    const PetscInt* con;
+    HS_PETSC(PetscSectionGetConstraintIndices(ls, p, &con));
+    for (PetscInt k = 0; k < n_con; ++k) {
+      const PetscInt i = con[k];
+      support[i] = PetscRealPart(f_int[off + i]) - load[i];
+      out.reaction_force[i] += support[i];
+    }
+    add_moment(y, support, out.reaction_moment);
+  }
+  HS_PETSC(VecRestoreArrayRead(coords, &xa));
+  for (auto* v : {&out.reaction_force, &out.reaction_moment, &out.applied_force,
+                  &out.applied_moment, &out.applied_moment_reference})
+    MPI_Allreduce(MPI_IN_PLACE, v->data(), 3, MPI_DOUBLE, MPI_SUM, comm());
+  return out;
 }
 
 double Problem::max_displacement(Vec u) const {

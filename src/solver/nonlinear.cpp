@@ -500,7 +500,14 @@ TargetResult NonlinearSolver::follow_path(double target, double start) {
   t.alpha = s_;
   t.negative_pivots = negative_pivots_;
   t.converged = d == target && !(negative_pivots_ > 0);
-  if (t.converged) t.reason = "target reached";
+  if (t.converged) {
+    // Leave the SNES as a load-controlled solve would (set up, callbacks at this load); at a
+    // converged state this is one residual evaluation and zero Newton iterations.
+    SolveResult check;
+    t.converged = newton(s_, check);
+    t.newton_iterations += check.newton_iterations;
+    t.reason = t.converged ? "target reached" : "final check: " + check.reason;
+  }
   return t;
 }
 

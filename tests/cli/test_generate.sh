@@ -133,6 +133,8 @@ expect split_sum       's/^seed: 7/seed: 7\nsplit: {train: 0.9, val: 0.2, test: 
 expect shard_size      's/shard_size: 2/shard_size: 0/'                    "output.shard_size"
 expect preset          's/preset: random2d/preset: random9d/'              "preset"
 expect solver          's/^seed: 7/seed: 7\nsolver: {rtol: 2}/'             "solver.rtol"
+expect control         's/^seed: 7/seed: 7\nsolver: {control: arclength}/' "solver.control"
+expect budget          's/^seed: 7/seed: 7\nsolver: {newton_budget: 0}/'   "solver.newton_budget"
 expect petsc           's/^seed: 7/seed: 7\npetsc: {pc_type: [lu]}/'       "petsc.pc_type"
 expect shapes_h        's/h: 0.1/h: -1/'                                   "shapes.h"
 expect surface_missing 's/preset: random2d/preset: random3d/; s/shapes: {count: 5, h: 0.1}/shapes: {count: 5, base: file, base_file: nowhere.stl}/' "shapes.base_file"

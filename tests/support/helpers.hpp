@@ -125,6 +125,14 @@ inline std::vector<hs::physics::EffectPtr> disk_effects(double E = 500, double n
   return e;
 }
 
+/// The unit ball with its boundary meshed to a Dirichlet patch near (1, 0, 0) (r = 0.5), the 3D
+/// analogue of disk_mesh.
+inline hs::mesh::MeshData ball_mesh(double h) {
+  hs::mesh::MeshOptions mo;
+  mo.h = h;
+  return hs::mesh::mesh_ball(mo, hs::mesh::ClampRegion{{1.0, 0.0, 0.0}, 0.5});
+}
+
 inline hs::physics::SpaceOptions degree(int p) {
   hs::physics::SpaceOptions o;
   o.degree = p;

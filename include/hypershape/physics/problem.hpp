@@ -2,6 +2,7 @@
 /// A problem = a mesh, a discrete space and the effects of a scene. Assembles, on global
 /// vectors, R(u) = f_int(u) - s f_ext (s: the load factor, alpha for the Gaussian traction),
 /// its tangent, and the potential energy Pi(u) = int W(F) - s f_ext . u.
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -17,6 +18,29 @@ namespace hypershape::physics {
 struct NodalField {
   int n_components = 0;
   std::vector<double> values;  ///< n_nodes x n_components, rank 0 only
+};
+
+/// Total forces and moments (about the origin) on the body at a state u and load factor s.
+/// Moments are 3-vectors; in 2D only the z component (x F_y - y F_x) is non-zero.
+///
+/// The support force at a constrained dof is what the residual leaves there: the internal force
+/// minus the applied load, (f_int(u) - s f_ext)_k, k constrained. The applied force is
+/// s sum_a f_ext_a = s int t dS_0 (the facet rule of the load), the applied moment
+/// s sum_a (x_a + u_a) x f_ext_a = s int (x + u) x t dS_0: dead loads act where the material
+/// point is now. With every dof, sum_a f_int_a = 0 and sum_a (x_a + u_a) x f_int_a = 0 hold
+/// exactly for any u (translation invariance; frame indifference, tau = P F^T symmetric, and
+/// x + u_h lies in the discrete space), so
+///   reaction_force + applied_force = -sum_free r_k,
+///   reaction_moment + applied_moment = -sum_free (x + u)_k x r_k,
+/// with r the free-dof residual: both vanish at equilibrium. The moment in the reference
+/// positions, s int x x t dS_0, differs by s int u x t dS_0 and does not balance.
+struct Resultants {
+  bool admissible = true;                   ///< false if det F <= 0 somewhere (then garbage)
+  std::array<double, 3> reaction_force{};   ///< exerted on the body by the essential conditions
+  std::array<double, 3> reaction_moment{};  ///< sum over constrained dofs of (x + u) x force
+  std::array<double, 3> applied_force{};    ///< s int t dS_0
+  std::array<double, 3> applied_moment{};   ///< s int (x + u) x t dS_0 (deformed positions)
+  std::array<double, 3> applied_moment_reference{};  ///< s int x x t dS_0 (reference positions)
 };
 
 class Problem {
@@ -45,6 +69,10 @@ class Problem {
   /// (PetscDS), for cross-checks and timings. Collective.
   void residual_pointwise(Vec u, Vec r) const;
   void jacobian_pointwise(Vec u, Mat J) const;
+
+  /// Reaction of the essential conditions and resultant of the load s f_ext at the state u
+  /// (global vector), reduced over the communicator: every rank gets the totals. Collective.
+  Resultants resultants(Vec u, double load_factor) const;
 
   /// max over nodes of |u| (collective).
   double max_displacement(Vec u) const;
