@@ -46,26 +46,6 @@ class LocalArray {
   bool write_;
 };
 
-/// Coordinates of the node carried by local point p: a vertex, or the midpoint of an edge (P2).
-std::array<double, 3> node_position(DM dm, PetscSection cs, const PetscScalar* xa, PetscInt p,
-                                    int dim) {
-  auto vertex = [&](PetscInt v) {
-    PetscInt off;
-    HS_PETSC(PetscSectionGetOffset(cs, v, &off));
-    std::array<double, 3> x{};
-    for (int k = 0; k < dim; ++k) x[k] = PetscRealPart(xa[off + k]);
-    return x;
-  };
-  PetscInt depth;
-  HS_PETSC(DMPlexGetPointDepth(dm, p, &depth));
-  if (depth == 0) return vertex(p);
-  const PetscInt* cone;
-  HS_PETSC(DMPlexGetCone(dm, p, &cone));
-  auto a = vertex(cone[0]), b = vertex(cone[1]);
-  for (int k = 0; k < 3; ++k) a[k] = 0.5 * (a[k] + b[k]);
-  return a;
-}
-
 /// m += x × f (3-vectors; 2D vectors have a zero third component).
 void add_moment(const double* x, const double* f, std::array<double, 3>& m) {
   m[0] += x[1] * f[2] - x[2] * f[1];
@@ -224,7 +204,7 @@ Resultants Problem::resultants(Vec u, double load_factor) const {
     if (n_dof == 0) continue;
     HS_PETSC(PetscSectionGetOffset(ls, p, &off));
     HS_PETSC(PetscSectionGetConstraintDof(ls, p, &n_con));
-    const std::array<double, 3> x = node_position(dm(), cs, xa, p, dim);
+    const std::array<double, 3> x = Space::node_coords(dm(), cs, xa, p, dim);
     double y[3] = {0, 0, 0}, load[3] = {0, 0, 0}, support[3] = {0, 0, 0};
     for (int i = 0; i < dim; ++i) {
       y[i] = x[i] + PetscRealPart(a[off + i]);

@@ -29,19 +29,6 @@ std::array<double, 3> vertex_coords(PetscSection cs, const PetscScalar* xa, Pets
   return x;
 }
 
-/// Coordinates of the node carried by point p (a vertex, or the midpoint of an edge).
-std::array<double, 3> node_coords(DM dm, PetscSection cs, const PetscScalar* xa, PetscInt p,
-                                  int dim) {
-  PetscInt depth;
-  HS_PETSC(DMPlexGetPointDepth(dm, p, &depth));
-  if (depth == 0) return vertex_coords(cs, xa, p, dim);
-  const PetscInt* cone;
-  HS_PETSC(DMPlexGetCone(dm, p, &cone));
-  auto a = vertex_coords(cs, xa, cone[0], dim), b = vertex_coords(cs, xa, cone[1], dim);
-  for (int k = 0; k < 3; ++k) a[k] = 0.5 * (a[k] + b[k]);
-  return a;
-}
-
 /// Closure points of `p` of depth `depth`, in closure order.
 std::vector<PetscInt> closure_of_depth(DM dm, PetscInt p, PetscInt d0, PetscInt d1) {
   PetscInt n, *cl = nullptr;
@@ -54,6 +41,19 @@ std::vector<PetscInt> closure_of_depth(DM dm, PetscInt p, PetscInt d0, PetscInt 
 }
 
 }  // namespace
+
+std::array<double, 3> Space::node_coords(DM dm, PetscSection cs, const PetscScalar* xa, PetscInt p,
+                                         int dim) {
+  PetscInt depth;
+  HS_PETSC(DMPlexGetPointDepth(dm, p, &depth));
+  if (depth == 0) return vertex_coords(cs, xa, p, dim);
+  const PetscInt* cone;
+  HS_PETSC(DMPlexGetCone(dm, p, &cone));
+  auto a = vertex_coords(cs, xa, cone[0], dim), b = vertex_coords(cs, xa, cone[1], dim);
+  for (int k = 0; k < 3; ++k) a[k] = 0.5 * (a[k] + b[k]);
+  return a;
+}
+
 
 Space::Space(core::DMH dm, DM serial, PetscSF migration, const SpaceOptions& opt,
              const std::vector<EssentialBC>& bcs)

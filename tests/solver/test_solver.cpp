@@ -12,26 +12,6 @@ using namespace hypershape;
 
 namespace {
 
-std::vector<double> values(Vec v) {
-  PetscInt n;
-  HS_PETSC(VecGetLocalSize(v, &n));
-  const PetscScalar* a;
-  HS_PETSC(VecGetArrayRead(v, &a));
-  std::vector<double> out(a, a + n);
-  HS_PETSC(VecRestoreArrayRead(v, &a));
-  return out;
-}
-
-bool bitwise_equal(const std::vector<double>& a, const std::vector<double>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
-}
-
-bool all_finite(const std::vector<double>& a) {
-  for (double v : a)
-    if (!std::isfinite(v)) return false;
-  return true;
-}
-
 /// The disk scene of the seed paper at h = 0.05, P1.
 struct DiskScene {
   physics::Problem problem{PETSC_COMM_WORLD, hstest::disk_mesh(0.05), hstest::disk_effects(),
@@ -57,9 +37,9 @@ TEST_CASE("solve_for_target reaches max|u| = 0.3 on the disk", "[solver]") {
   CHECK(std::abs(m / 0.3 - 1.0) <= 1e-3);
   // Admissible and clean.
   CHECK(p.min_det_f(ns.solution()) > 0);
-  CHECK(all_finite(values(ns.solution())));
+  CHECK(hstest::all_finite(hstest::values(ns.solution())));
   const auto u = p.gather(ns.solution());
-  CHECK(all_finite(u.values));
+  CHECK(hstest::all_finite(u.values));
   // In equilibrium at alpha: ||R|| <= rtol ||alpha f_ext|| (+ atol).
   core::VecH r = p.create_vector();
   REQUIRE(p.residual(ns.solution(), t.alpha, r));
@@ -142,7 +122,7 @@ TEST_CASE("The guard turns an element-inverting Newton step into a converged sol
     CHECK(r.load_factor == alpha);
     CHECK(p.min_det_f(ns.solution()) > 0);
     CHECK(r.max_displacement == Approx(1.0).epsilon(2e-3));
-    CHECK(all_finite(values(ns.solution())));
+    CHECK(hstest::all_finite(hstest::values(ns.solution())));
   }
 }
 
@@ -153,28 +133,28 @@ TEST_CASE("Solves are bitwise reproducible after reset()", "[solver]") {
 
   const auto r1 = ns.solve(20.0);
   REQUIRE(r1.converged);
-  const auto u1 = values(ns.solution());
+  const auto u1 = hstest::values(ns.solution());
   ns.reset();
   CHECK(ns.load_factor() == 0.0);
   const auto r2 = ns.solve(20.0);
   REQUIRE(r2.converged);
-  CHECK(bitwise_equal(u1, values(ns.solution())));
+  CHECK(hstest::bitwise_equal(u1, hstest::values(ns.solution())));
   CHECK(r1.newton_iterations == r2.newton_iterations);
   CHECK(r1.max_displacement == r2.max_displacement);
 
   ns.reset();
   const auto t1 = ns.solve_for_target(0.3);
   REQUIRE(t1.converged);
-  const auto v1 = values(ns.solution());
+  const auto v1 = hstest::values(ns.solution());
   ns.reset();
   const auto t2 = ns.solve_for_target(0.3);
   REQUIRE(t2.converged);
   CHECK(t1.alpha == t2.alpha);
   CHECK(t1.solves == t2.solves);
   CHECK(t1.max_displacement == t2.max_displacement);
-  CHECK(bitwise_equal(v1, values(ns.solution())));
+  CHECK(hstest::bitwise_equal(v1, hstest::values(ns.solution())));
   // A different load really gives a different state (the comparison can fail).
-  CHECK_FALSE(bitwise_equal(u1, v1));
+  CHECK_FALSE(hstest::bitwise_equal(u1, v1));
 }
 
 TEST_CASE("Continuing from a converged state reaches the same equilibrium", "[solver]") {
@@ -239,7 +219,7 @@ TEST_CASE("Failed increments are recovered and their cost counted; a spent budge
     CHECK(t.recovery_iterations < t.newton_iterations);
     if (t.converged) CHECK(std::abs(t.max_displacement / 0.6 - 1) <= 1e-3);
     CHECK(p.min_det_f(ns.solution()) > 0);
-    CHECK(all_finite(values(ns.solution())));
+    CHECK(hstest::all_finite(hstest::values(ns.solution())));
   }
   SECTION("a budget of 3 Newton iterations cannot reach max|u| = 1") {
     solver::SolverOptions o;
@@ -252,6 +232,6 @@ TEST_CASE("Failed increments are recovered and their cost counted; a spent budge
     CHECK(t.newton_iterations <= 3);
     // The state is the last converged one: admissible and finite.
     CHECK(p.min_det_f(ns.solution()) > 0);
-    CHECK(all_finite(values(ns.solution())));
+    CHECK(hstest::all_finite(hstest::values(ns.solution())));
   }
 }

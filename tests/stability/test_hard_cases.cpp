@@ -86,20 +86,6 @@ class Table {
   std::vector<Row> rows_;
 };
 
-std::vector<double> local_values(Vec v) {
-  PetscInt n;
-  HS_PETSC(VecGetLocalSize(v, &n));
-  const PetscScalar* a;
-  HS_PETSC(VecGetArrayRead(v, &a));
-  std::vector<double> out(a, a + n);
-  HS_PETSC(VecRestoreArrayRead(v, &a));
-  return out;
-}
-
-bool all_finite(const std::vector<double>& a) {
-  return std::all_of(a.begin(), a.end(), [](double v) { return std::isfinite(v); });
-}
-
 /// The stability contract on the state the solver hands back after a solve (see the file
 /// comment). `target` is NaN for a load-controlled solve. `admissible_start` is false when the
 /// test itself planted an inadmissible state that a failed solve may leave in place.
@@ -108,9 +94,9 @@ void check_state(const physics::Problem& p, Vec u, const solver::SolverOptions& 
   INFO(row.name << ": " << (row.converged ? "converged" : "failed") << " (" << row.reason
                 << "), alpha " << row.alpha << ", max|u| " << row.max_u << ", min det F "
                 << row.min_det_f);
-  REQUIRE(all_finite(local_values(u)));
+  REQUIRE(hstest::all_finite(hstest::values(u)));
   const auto nodal = p.gather(u);
-  REQUIRE(all_finite(nodal.values));
+  REQUIRE(hstest::all_finite(nodal.values));
   REQUIRE(std::isfinite(row.max_u));
   if (!row.converged) {
     CHECK_FALSE(row.reason.empty());

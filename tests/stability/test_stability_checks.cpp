@@ -36,21 +36,6 @@ using KSPH = core::Handle<KSP, KSPDestroy>;
 double norm(const Vec3& v) { return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
 Vec3 add(const Vec3& a, const Vec3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
 
-/// Entries of this rank's part of a global vector.
-std::vector<double> values(Vec v) {
-  PetscInt n;
-  HS_PETSC(VecGetLocalSize(v, &n));
-  const PetscScalar* a;
-  HS_PETSC(VecGetArrayRead(v, &a));
-  std::vector<double> out(a, a + n);
-  HS_PETSC(VecRestoreArrayRead(v, &a));
-  return out;
-}
-
-bool bitwise_equal(const std::vector<double>& a, const std::vector<double>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
-}
-
 // ---- scenes ---------------------------------------------------------------------------------
 
 /// The seed paper's clamp-and-pull scene in a form that can be rotated as a whole: a mesh, a
@@ -146,7 +131,7 @@ core::VecH linear_state(const physics::Problem& p, double s) {
 Vec3 free_residual_sum(const physics::Problem& p, Vec u, double s) {
   core::VecH r = p.create_vector();
   REQUIRE(p.residual(u, s, r));
-  const auto v = values(r);
+  const auto v = hstest::values(r);
   const int dim = p.space().dim();
   Vec3 out{};
   for (std::size_t k = 0; k < v.size(); ++k) out[k % dim] += v[k];
@@ -590,12 +575,12 @@ TEST_CASE("A target solve repeated with fresh objects is bitwise identical", "[s
     solver::NonlinearSolver ns(p);
     const auto t = ns.solve_for_target(target);
     REQUIRE(t.converged);
-    return std::make_pair(t, values(ns.solution()));
+    return std::make_pair(t, hstest::values(ns.solution()));
   };
   auto check = [&](const Scene& scene, int degree) {
     const auto [t1, u1] = run(scene, degree, 0.3);
     const auto [t2, u2] = run(scene, degree, 0.3);
-    CHECK(bitwise_equal(u1, u2));
+    CHECK(hstest::bitwise_equal(u1, u2));
     CHECK(t1.alpha == t2.alpha);
     CHECK(t1.max_displacement == t2.max_displacement);
     CHECK(t1.newton_iterations == t2.newton_iterations);
@@ -603,7 +588,7 @@ TEST_CASE("A target solve repeated with fresh objects is bitwise identical", "[s
     CHECK(t1.failed_increments == t2.failed_increments);
     // The comparison can fail: a slightly different target gives other bits.
     const auto [t3, u3] = run(scene, degree, 0.31);
-    CHECK_FALSE(bitwise_equal(u1, u3));
+    CHECK_FALSE(hstest::bitwise_equal(u1, u3));
     CHECK(t1.alpha != t3.alpha);
   };
   SECTION("disk P1") { check(disk_scene(0.05), 1); }

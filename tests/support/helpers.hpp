@@ -5,6 +5,7 @@
 #include <petscdmplex.h>
 
 #include <cmath>
+#include <cstring>
 #include <functional>
 #include <random>
 #include <vector>
@@ -22,6 +23,27 @@ using Field = std::function<void(const double* x, double* u)>;
 
 /// A local vector of the problem's DM holding the global vector `u`, with the homogeneous
 /// essential values (zero) in the constrained slots. Collective.
+/// Entries of this rank's part of a global vector.
+inline std::vector<double> values(Vec v) {
+  PetscInt n;
+  HS_PETSC(VecGetLocalSize(v, &n));
+  const PetscScalar* a;
+  HS_PETSC(VecGetArrayRead(v, &a));
+  std::vector<double> out(a, a + n);
+  HS_PETSC(VecRestoreArrayRead(v, &a));
+  return out;
+}
+
+inline bool bitwise_equal(const std::vector<double>& a, const std::vector<double>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+}
+
+inline bool all_finite(const std::vector<double>& a) {
+  for (double v : a)
+    if (!std::isfinite(v)) return false;
+  return true;
+}
+
 inline hs::core::VecH local_copy(const hs::physics::Problem& p, Vec u) {
   hs::core::VecH ul;
   HS_PETSC(DMCreateLocalVector(p.dm(), ul.out()));

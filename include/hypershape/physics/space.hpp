@@ -83,6 +83,10 @@ class Space {
   /// Value of facet node `ends` at barycentric `bary` (P1: lambda_a; P2: quadratic).
   double facet_basis(const std::array<int, 2>& ends, const double* bary) const;
   static double facet_measure(const FacetView& f, int dim);
+  /// Coordinates of the node carried by plex point p (a vertex, or the midpoint of an edge for
+  /// P2), from the coordinate section `cs` and local coordinate array `xa`.
+  static std::array<double, 3> node_coords(DM dm, PetscSection cs, const PetscScalar* xa,
+                                           PetscInt p, int dim);
 
   /// Owned dof-carrying points: local offset, canonical node id, coordinates. Each node of the
   /// mesh is owned by exactly one rank.
