@@ -4,9 +4,12 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstring>
+#include <vector>
 
 #include "hypershape/solver/nonlinear.hpp"
 #include "support/helpers.hpp"
+
+#include <petscblaslapack.h>
 
 using namespace hypershape;
 
@@ -233,5 +236,51 @@ TEST_CASE("Failed increments are recovered and their cost counted; a spent budge
     // The state is the last converged one: admissible and finite.
     CHECK(p.min_det_f(ns.solution()) > 0);
     CHECK(hstest::all_finite(hstest::values(ns.solution())));
+  }
+}
+
+TEST_CASE("The inertia of LDL^T counts the negative eigenvalues, with PETSc's factorisation and MUMPS's", "[solver]") {
+  // A small tangent K (disk, h 0.25, P1), shifted by sigma between consecutive eigenvalues:
+  // the number of negative eigenvalues of K - sigma I is known from a dense eigensolve.
+  physics::Problem p{PETSC_COMM_WORLD, hstest::disk_mesh(0.25), hstest::disk_effects(), hstest::degree(1)};
+  core::VecH u = p.create_vector();
+  core::MatH K = p.create_matrix();
+  REQUIRE(p.jacobian(u, K));
+  Mat D;
+  HS_PETSC(MatConvert(K, MATDENSE, MAT_INITIAL_MATRIX, &D));
+  PetscInt n;
+  HS_PETSC(MatGetSize(D, &n, nullptr));
+  std::vector<PetscScalar> a(n * n), w(n), work(8 * n);
+  {
+    const PetscScalar* d;
+    HS_PETSC(MatDenseGetArrayRead(D, &d));
+    std::copy(d, d + n * n, a.begin());
+    HS_PETSC(MatDenseRestoreArrayRead(D, &d));
+  }
+  HS_PETSC(MatDestroy(&D));
+  PetscBLASInt bn = PetscBLASInt(n), lwork = PetscBLASInt(work.size()), info;
+  LAPACKsyev_("N", "U", &bn, a.data(), &bn, w.data(), work.data(), &lwork, &info);
+  REQUIRE(info == 0);  // w ascending
+  REQUIRE(w[0] > 0);   // the clamped body's tangent at rest is positive definite
+  const int counts[] = {0, 1, 2, 7, int(n) / 3, int(n) / 2};
+  for (const char* package : {MATSOLVERPETSC, MATSOLVERMUMPS}) {
+    for (int k : counts) {
+      const double sigma = k == 0 ? 0.0 : 0.5 * (w[k - 1] + w[k]);
+      core::MatH S;
+      HS_PETSC(MatDuplicate(K, MAT_COPY_VALUES, S.out()));
+      HS_PETSC(MatShift(S, -sigma));
+      KSP ksp;
+      PC pc;
+      HS_PETSC(KSPCreate(PETSC_COMM_WORLD, &ksp));
+      HS_PETSC(KSPSetType(ksp, KSPPREONLY));
+      HS_PETSC(KSPGetPC(ksp, &pc));
+      HS_PETSC(PCSetType(pc, PCCHOLESKY));
+      HS_PETSC(PCFactorSetMatSolverType(pc, package));
+      HS_PETSC(KSPSetOperators(ksp, S, S));
+      HS_PETSC(KSPSetUp(ksp));
+      INFO(package << ": sigma between eigenvalues " << k << " and " << k + 1 << " of " << n);
+      CHECK(solver::negative_eigenvalues(ksp) == k);
+      HS_PETSC(KSPDestroy(&ksp));
+    }
   }
 }

@@ -8,8 +8,11 @@
 ///   on Armijo decrease of the potential energy, or of the residual norm where the tangent is
 ///   indefinite or the energy change is below round-off. (PETSc 3.18's bt with an objective
 ///   models 1/2 obj with the full slope and stalls on indefinite tangents: measured here.)
-///   -ksp_type preonly -pc_type cholesky -pc_factor_mat_solver_type mumps (the Neo-Hookean
-///   tangent is symmetric; LDL^T was 1.6x faster than LU here);
+///   -ksp_type preonly -pc_type cholesky (the Neo-Hookean tangent is symmetric; LDL^T was 1.6x
+///   faster than LU here) with -pc_factor_mat_solver_type petsc -pc_factor_mat_ordering_type
+///   qmd on one rank (PETSc's own LDL^T: 1.4x faster per load case than MUMPS on Random2D
+///   shapes of ~4500 unknowns, whose per-call overhead dominates there) and mumps on a solver
+///   group of several ranks;
 ///   -snes_stol 0 (a small step is not convergence: the residual must be small).
 /// Load continuation (solve): if a step fails, return to the last converged state and halve
 /// the increment; after a success, double it.
@@ -45,6 +48,11 @@
 
 namespace hypershape::solver {
 
+/// The number of negative eigenvalues of the matrix a Cholesky (LDL^T) KSP has factored, by
+/// Sylvester's law of inertia: the negative pivots of MUMPS (INFOG(12)) or of PETSc's own
+/// factorisation (MatGetInertia). -1 where the KSP holds no such factorisation.
+int negative_eigenvalues(KSP ksp);
+
 /// How solve_for_target reaches its target max|u|.
 enum class Control {
   displacement,  ///< path-following in d = max|u| with alpha as an unknown (default)
@@ -55,7 +63,7 @@ struct SolverOptions {
   double rtol = 1e-9;          ///< converged when ||R|| <= rtol ||alpha f_ext|| (+ atol)
   double atol = 1e-12;
   Control control = Control::displacement;
-  double path_rtol = 1e-2;     ///< displacement control: rtol of intermediate increments
+  double path_rtol = 0.3;      ///< displacement control: rtol of intermediate increments
   int newton_budget = 200;     ///< Newton iterations per solve / target solve (then: failure)
   bool fallback = false;       ///< displacement control failed: try load control from there
   int max_newton = 12;         ///< Newton iterations per increment (then: smaller increment)
@@ -153,6 +161,7 @@ class NonlinearSolver {
   core::VecH a_, a0_, b_, c_, du_, w_;  ///< displacement-control work vectors
   double s_ = 0;        ///< load factor of the current state
   double s_eval_ = 0;   ///< load factor the callbacks assemble at
+  double step_hint_ = 0;
   int negative_pivots_ = -1;  ///< inertia of the last tangent_response() (-1: unknown)
   bool user_atol_ = false;
 };
