@@ -96,6 +96,25 @@ bool all_finite(const std::vector<double>& v) {
 
 }  // namespace
 
+ShapeProblem make_shape_problem(MPI_Comm group, const config::DatasetConfig& cfg,
+                                const ShapeSample& shape, const LoadCase& first) {
+  const int d = cfg.shapes.dim;
+  std::vector<physics::EffectPtr> effects;
+  effects.push_back(physics::make_neo_hookean(cfg.material.E, cfg.material.nu));
+  effects.push_back(physics::make_dirichlet_patch(
+      std::vector<double>(shape.dirichlet_center.begin(), shape.dirichlet_center.begin() + d),
+      shape.dirichlet_radius));
+  auto gt = std::make_unique<physics::GaussianTraction>(
+      std::vector<double>(first.center.begin(), first.center.begin() + d),
+      std::vector<double>(first.direction.begin(), first.direction.begin() + d), cfg.loads.gamma);
+  ShapeProblem out;
+  out.traction = gt.get();
+  effects.push_back(std::move(gt));
+  out.problem = std::make_unique<physics::Problem>(group, shape.mesh, std::move(effects),
+                                                   physics::SpaceOptions{cfg.degree});
+  return out;
+}
+
 ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
                          const std::optional<geometry::Boundary>& base, std::int64_t shape_id,
                          const std::function<void(bool)>& on_load) {
@@ -136,18 +155,9 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
   physics::GaussianTraction* traction = nullptr;
   {
     auto t = out.times.scope("setup");
-    std::vector<physics::EffectPtr> effects;
-    effects.push_back(physics::make_neo_hookean(cfg.material.E, cfg.material.nu));
-    effects.push_back(physics::make_dirichlet_patch(
-        std::vector<double>(shape.dirichlet_center.begin(), shape.dirichlet_center.begin() + d),
-        shape.dirichlet_radius));
-    auto gt = std::make_unique<physics::GaussianTraction>(
-        std::vector<double>(cases[0].center.begin(), cases[0].center.begin() + d),
-        std::vector<double>(cases[0].direction.begin(), cases[0].direction.begin() + d), cfg.loads.gamma);
-    traction = gt.get();
-    effects.push_back(std::move(gt));
-    problem = std::make_unique<physics::Problem>(group, shape.mesh, std::move(effects),
-                                                 physics::SpaceOptions{cfg.degree});
+    ShapeProblem sp = make_shape_problem(group, cfg, shape, cases[0]);
+    problem = std::move(sp.problem);
+    traction = sp.traction;
     nl = std::make_unique<solver::NonlinearSolver>(*problem, cfg.solver);
   }
   const auto& space = problem->space();

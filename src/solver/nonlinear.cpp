@@ -45,7 +45,7 @@ NonlinearSolver::NonlinearSolver(const physics::Problem& problem, const SolverOp
   u_ = problem.create_vector();
   backup_ = problem.create_vector();
   r_ = problem.create_vector();
-  for (core::VecH* v : {&a_, &a0_, &b_, &c_, &du_, &w_}) *v = problem.create_vector();
+  for (core::VecH* v : {&a_, &a0_, &b_, &c_, &du_, &w_, &v_, &v0_}) *v = problem.create_vector();
   HS_PETSC(SNESCreate(comm, snes_.out()));
   if (!prefix.empty()) HS_PETSC(SNESSetOptionsPrefix(snes_, prefix.c_str()));
   // No SNESSetDM: SNES callbacks live on the DM's DMSNES, so solvers sharing the problem's DM
@@ -69,13 +69,14 @@ NonlinearSolver::NonlinearSolver(const physics::Problem& problem, const SolverOp
   HS_PETSC(KSPSetType(ksp, KSPPREONLY));
   HS_PETSC(KSPGetPC(ksp, &pc));
   HS_PETSC(PCSetType(pc, PCCHOLESKY));
-  // One rank: PETSc's own sparse Cholesky (LDL^T without pivoting) in the quotient minimum
-  // degree ordering; measured 1.4x faster per load case than MUMPS on Random2D shapes, whose
-  // per-call overhead dominates at a few thousand unknowns (scripts/bench_factor.sh). A
-  // solver group of several ranks: MUMPS. Both report the inertia (tangent_response).
+  // 2D on one rank: PETSc's own sparse Cholesky (LDL^T without pivoting) in the quotient
+  // minimum degree ordering; measured 1.4x faster per load case than MUMPS on Random2D shapes,
+  // whose per-call overhead dominates at a few thousand unknowns. In 3D its non-supernodal
+  // factorisation is far slower than MUMPS (a Random3D load case took minutes), and a solver
+  // group of several ranks needs a parallel one: MUMPS. Both report the inertia.
   PetscMPIInt ranks;
   MPI_Comm_size(comm, &ranks);
-  if (ranks == 1) {
+  if (ranks == 1 && problem.space().dim() == 2) {
     HS_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERPETSC));
     HS_PETSC(PCFactorSetMatOrderingType(pc, MATORDERINGQMD));
   } else {
@@ -263,6 +264,10 @@ TargetResult NonlinearSolver::solve_for_target(double target) {
   const double start = core::now_seconds();
   TargetResult t = opt_.control == Control::displacement ? follow_path(target, start)
                                                           : search_target(target, start);
+  for (int k = 0; k < opt_.branch_switches && opt_.control == Control::displacement && !t.converged &&
+                  target > 0 && t.newton_iterations < opt_.newton_budget;
+       ++k)
+    switch_branch(target, start, k, t);
   if (opt_.control == Control::displacement && !t.converged && opt_.fallback && target > 0) {
     // Fallback, measured on Random2D draws: where the path cannot be followed (Newton stalls
     // next to a bifurcation), load-controlled solves from the last converged state of the
@@ -431,7 +436,155 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
   }
 }
 
-TargetResult NonlinearSolver::follow_path(double target, double start) {
+double NonlinearSolver::softest_mode() {
+  // Start: a pseudo-random vector keyed by the canonical node numbers (the same on any rank
+  // count), so that no mode is missing from it by symmetry.
+  DM dm = problem_.dm();
+  const int dim = problem_.space().dim();
+  Vec xl;
+  HS_PETSC(DMGetLocalVector(dm, &xl));
+  HS_PETSC(VecSet(xl, 0.0));
+  PetscScalar* x;
+  HS_PETSC(VecGetArray(xl, &x));
+  for (const auto& n : problem_.space().owned_nodes())
+    for (int i = 0; i < dim; ++i) {
+      std::uint64_t h = std::uint64_t(n.canonical) * 0x9E3779B97F4A7C15ull + std::uint64_t(i + 1);
+      h ^= h >> 31;
+      h *= 0xBF58476D1CE4E5B9ull;
+      h ^= h >> 29;
+      x[n.offset + i] = double(h >> 11) / double(1ull << 53) - 0.5;
+    }
+  HS_PETSC(VecRestoreArray(xl, &x));
+  HS_PETSC(DMLocalToGlobal(dm, xl, INSERT_VALUES, v_));
+  HS_PETSC(DMRestoreLocalVector(dm, &xl));
+  KSP ksp;
+  HS_PETSC(SNESGetKSP(snes_, &ksp));
+  for (int k = 0; k < 8; ++k) {  // K is factored (tangent_response): 8 back-substitutions
+    PetscReal n;
+    HS_PETSC(VecNormalize(v_, &n));
+    HS_PETSC(KSPSolve(ksp, v_, w_));
+    HS_PETSC(VecCopy(w_, v_));
+  }
+  PetscReal vmax, vv, vkv;
+  HS_PETSC(VecNorm(v_, NORM_INFINITY, &vmax));
+  HS_PETSC(VecScale(v_, 1.0 / vmax));
+  HS_PETSC(MatMult(J_, v_, w_));
+  HS_PETSC(VecDot(v_, w_, &vkv));
+  HS_PETSC(VecDot(v_, v_, &vv));
+  return vkv / vv;
+}
+
+bool NonlinearSolver::minimise(double s, int& its, std::string& why) {
+  KSP ksp;
+  HS_PETSC(SNESGetKSP(snes_, &ksp));
+  const double fnorm = problem_.load_norm();
+  double mu = 0, mu0 = 0;
+  for (int k = 0;; ++k) {
+    if (!problem_.residual(u_, s, r_)) {
+      why = "inadmissible state (det F <= 0)";
+      return false;
+    }
+    PetscReal rn;
+    HS_PETSC(VecNorm(r_, NORM_2, &rn));
+    if (!std::isfinite(rn)) {
+      why = "non-finite residual";
+      return false;
+    }
+    if (mu == 0 && negative_pivots_ == 0 && rn <= opt_.atol + opt_.rtol * std::abs(s) * fnorm) return true;
+    if (k == 4 * opt_.max_newton || its >= opt_.newton_budget) {
+      why = "energy minimisation: no convergence in " + std::to_string(k) + " iterations";
+      return false;
+    }
+    ++its;
+    if (!problem_.jacobian(u_, J_)) {
+      why = "tangent could not be formed";
+      return false;
+    }
+    if (mu0 == 0) {  // the shift's scale: the mean diagonal entry of the tangent
+      HS_PETSC(MatGetDiagonal(J_, w_));
+      PetscReal sum;
+      PetscInt n;
+      HS_PETSC(VecSum(w_, &sum));
+      HS_PETSC(VecGetSize(w_, &n));
+      mu0 = 1e-3 * std::abs(sum) / double(n);
+    }
+    if (mu > 0) HS_PETSC(MatShift(J_, mu));
+    HS_PETSC(KSPSetOperators(ksp, J_, J_));
+    HS_PETSC(KSPSolve(ksp, r_, du_));
+    KSPConvergedReason kr;
+    HS_PETSC(KSPGetConvergedReason(ksp, &kr));
+    negative_pivots_ = kr > 0 ? negative_eigenvalues(ksp) : -1;
+    if (kr <= 0 || negative_pivots_ != 0) {  // indefinite (or failed): shift further
+      mu = mu == 0 ? mu0 : 4 * mu;
+      negative_pivots_ = -1;
+      continue;
+    }
+    const double lambda = backtrack(u_, du_, r_, s, w_, b_);
+    if (lambda == 0.0) {
+      mu = mu == 0 ? mu0 : 4 * mu;
+      negative_pivots_ = -1;
+      continue;
+    }
+    HS_PETSC(VecCopy(w_, u_));
+    if (mu > 0) {
+      negative_pivots_ = -1;  // the inertia of K itself is not known yet
+      if (lambda == 1.0) mu = mu < mu0 / 16 ? 0.0 : mu / 4;
+    }
+  }
+}
+
+void NonlinearSolver::switch_branch(double target, double start, int attempt, TargetResult& t) {
+  int its = 0;
+  std::string why;
+  if (attempt == 0) {
+    HS_PETSC(VecCopy(u_, v0_));
+    s0_ = s_;
+  } else {  // the state the path left, at a lower load: where the stable branch holds
+    HS_PETSC(VecCopy(v0_, u_));
+    s_ = s0_ * std::pow(0.7, attempt);
+  }
+  // Leave the state along the softest mode of the tangent (the buckling mode at a
+  // bifurcation, the near-null mode where Newton stalled), by the sign of lower energy.
+  bool ok = tangent_response();
+  if (ok) {
+    ++its;
+    softest_mode();
+    const double eps = 0.05 * target;
+    HS_PETSC(VecCopy(u_, backup_));
+    double e[2];
+    bool adm[2];
+    for (int k = 0; k < 2; ++k) {
+      HS_PETSC(VecWAXPY(w_, k == 0 ? eps : -eps, v_, backup_));
+      adm[k] = problem_.energy(w_, s_, e[k]);
+    }
+    const int pick = adm[0] && (!adm[1] || e[0] <= e[1]) ? 0 : 1;
+    ok = adm[pick];
+    if (ok) HS_PETSC(VecWAXPY(u_, pick == 0 ? eps : -eps, v_, backup_));
+    else why = "both perturbations along the softest mode invert elements";
+  } else {
+    why = "tangent factorisation failed";
+  }
+  if (ok) ok = minimise(s_, its, why);
+  const std::string before = t.reason;
+  t.newton_iterations += its;
+  t.recovery_iterations += its;
+  if (!ok) {
+    t.reason = before + "; branch switch failed: " + why;
+    return;
+  }
+  // On the new branch: a stable equilibrium at the same load. Follow it to the target.
+  TargetResult p = follow_path(target, start, t.newton_iterations);
+  p.solves += t.solves;
+  p.newton_iterations += t.newton_iterations;
+  p.failed_increments += t.failed_increments;
+  p.increments += t.increments;
+  p.recovery_iterations += t.recovery_iterations;
+  p.reason = p.converged ? "target reached after a branch switch (" + before + ")"
+                         : p.reason + " (after a branch switch from: " + before + ")";
+  t = p;
+}
+
+TargetResult NonlinearSolver::follow_path(double target, double start, int spent) {
   TargetResult t;
   if (!(target > 0) || !std::isfinite(target)) {
     t.reason = "target max|u| must be positive";
@@ -449,8 +602,11 @@ TargetResult NonlinearSolver::follow_path(double target, double start) {
   const bool from_rest = d == 0;
   if (from_rest && step_hint_ > 0) step = std::min(step, step_hint_);
   bool first_accepted = true;
-  const double min_step = std::abs(step) * opt_.min_increment;
-  int its = 0;
+  int failed_in_a_row = 0;
+  // Increments below 1e-3 of the way (or min_increment, if larger) are a stalled path: it
+  // creeps along a limit point (measured: the budget spent on increments of 1e-4 of the way).
+  const double min_step = std::abs(target - d) * std::max(opt_.min_increment, 1e-3);
+  int its = spent;  // the Newton budget counts what the target solve spent before
   std::string why;
   while (true) {
     const bool last = std::abs(target - d) <= std::abs(step) * (1 + 1e-12);
@@ -468,8 +624,10 @@ TargetResult NonlinearSolver::follow_path(double target, double start) {
     const double m = control_direction(u_, a_, c_);
     PetscReal ca;
     HS_PETSC(VecDot(c_, a_, &ca));
-    bool ok = ca > 0;
-    if (!ok) why = "limit point: max|u| does not grow with the load";
+    // c . a = d max|u| / d alpha along the path; negative past a limit point of the load (the
+    // path goes on at a falling load: displacement control passes limit points).
+    bool ok = std::isfinite(ca) && ca != 0.0;
+    if (!ok) why = "singular tangent: max|u| does not respond to the load";
     if (ok) {
       const double dalpha = (d_next - m) / ca;
       const double s_pred = s_backup + dalpha;
@@ -498,6 +656,7 @@ TargetResult NonlinearSolver::follow_path(double target, double start) {
     }
     if (ok) {
       ++t.increments;
+      failed_in_a_row = 0;
       if (first_accepted && from_rest) step_hint_ = d_next;
       first_accepted = false;
       d = d_next;
@@ -512,6 +671,10 @@ TargetResult NonlinearSolver::follow_path(double target, double start) {
     ++t.failed_increments;
     t.recovery_iterations += its - its_before;
     step *= 0.5;
+    if (++failed_in_a_row == opt_.max_halvings) {
+      t.reason = std::to_string(failed_in_a_row) + " failed increments in a row (last: " + why + ")";
+      break;
+    }
     if (its >= opt_.newton_budget) {
       t.reason = why;
       break;
@@ -521,7 +684,7 @@ TargetResult NonlinearSolver::follow_path(double target, double start) {
       break;
     }
   }
-  t.newton_iterations = its;
+  t.newton_iterations = its - spent;
   t.max_displacement = problem_.max_displacement(u_);
   t.alpha = s_;
   t.negative_pivots = negative_pivots_;

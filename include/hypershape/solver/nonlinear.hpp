@@ -10,9 +10,10 @@
 ///   models 1/2 obj with the full slope and stalls on indefinite tangents: measured here.)
 ///   -ksp_type preonly -pc_type cholesky (the Neo-Hookean tangent is symmetric; LDL^T was 1.6x
 ///   faster than LU here) with -pc_factor_mat_solver_type petsc -pc_factor_mat_ordering_type
-///   qmd on one rank (PETSc's own LDL^T: 1.4x faster per load case than MUMPS on Random2D
-///   shapes of ~4500 unknowns, whose per-call overhead dominates there) and mumps on a solver
-///   group of several ranks;
+///   qmd in 2D on one rank (PETSc's own LDL^T: 1.4x faster per load case than MUMPS on
+///   Random2D shapes of ~4500 unknowns, whose per-call overhead dominates there), mumps in 3D
+///   (where PETSc's non-supernodal factorisation is far slower) and on solver groups of
+///   several ranks;
 ///   -snes_stol 0 (a small step is not convergence: the residual must be small).
 /// Load continuation (solve): if a step fails, return to the last converged state and halve
 /// the increment; after a success, double it.
@@ -66,6 +67,8 @@ struct SolverOptions {
   double path_rtol = 0.3;      ///< displacement control: rtol of intermediate increments
   int newton_budget = 200;     ///< Newton iterations per solve / target solve (then: failure)
   bool fallback = false;       ///< displacement control failed: try load control from there
+  int branch_switches = 3;     ///< displacement control failed: leave the branch this often
+  int max_halvings = 6;        ///< displacement control: failed increments in a row (then: fail)
   int max_newton = 12;         ///< Newton iterations per increment (then: smaller increment)
   int max_increments = 64;     ///< continuation increments per solve
   double min_increment = 1e-4; ///< smallest increment, relative to the requested change
@@ -142,7 +145,9 @@ class NonlinearSolver {
   double backtrack(Vec X, Vec Y, Vec F, double s, Vec W, Vec G);
   bool newton(double s, SolveResult& r);
   TargetResult search_target(double target, double start);
-  TargetResult follow_path(double target, double start);
+  /// Displacement control from the current state to max|u| = target; `spent`: Newton
+  /// iterations the target solve spent before (counted against newton_budget).
+  TargetResult follow_path(double target, double start, int spent = 0);
   /// One corrector: Newton on (u, alpha) for max|u| = d (or alpha fixed when d < 0) from the
   /// current iterate in u_/s_; returns false with `why` set on failure. Leaves in `a_` the
   /// tangent response K^-1 f_ext of its last factorisation (the next predictor).
@@ -152,16 +157,29 @@ class NonlinearSolver {
   double control_direction(Vec u, Vec fallback, Vec c);
   /// Factorises K(u_) and solves K a_ = f_ext. False if the tangent cannot be formed.
   bool tangent_response();
+  /// After a failed path: leaves the state the path ended in (unstable, or where increments
+  /// kept failing) along the tangent's softest mode, minimises the energy there at 0.7^attempt
+  /// times its load (a stable state on another branch: past a subcritical bifurcation none is
+  /// near at the full load), and follows that branch to the target. Adds its cost to `t`.
+  void switch_branch(double target, double start, int attempt, TargetResult& t);
+  /// The eigenvector of K(u_) whose eigenvalue is nearest zero (inverse iteration from a
+  /// rank-independent pseudo-random vector), in v_, |v_|_inf = 1; returns its Rayleigh quotient.
+  double softest_mode();
+  /// Minimises the energy at load factor s from u_ by Newton with an inertia correction:
+  /// K + mu I, mu raised until LDL^T has no negative pivot, lowered after full steps. Ends at
+  /// an equilibrium whose tangent is positive definite, or returns false with `why`.
+  bool minimise(double s, int& its, std::string& why);
 
   const physics::Problem& problem_;
   SolverOptions opt_;
   core::SNESH snes_;
   core::MatH J_;
   core::VecH u_, backup_, r_;
-  core::VecH a_, a0_, b_, c_, du_, w_;  ///< displacement-control work vectors
+  core::VecH a_, a0_, b_, c_, du_, w_, v_, v0_;  ///< displacement-control work vectors
   double s_ = 0;        ///< load factor of the current state
   double s_eval_ = 0;   ///< load factor the callbacks assemble at
   double step_hint_ = 0;
+  double s0_ = 0;       ///< load factor of the state a branch switch left (in v0_)
   int negative_pivots_ = -1;  ///< inertia of the last tangent_response() (-1: unknown)
   bool user_atol_ = false;
 };
