@@ -22,7 +22,10 @@ void parse_solver_block(const YamlBlock& sol, solver::SolverOptions& s) {
   if (sol.has("newton_budget")) s.newton_budget = int(sol.integer("newton_budget"));
   if (s.newton_budget < 1) sol.fail("newton_budget", "must be >= 1");
   if (sol.has("fallback")) s.fallback = sol.boolean("fallback");
-  sol.allowed("rtol, max_newton, max_increments, target_rtol, control, path_rtol, newton_budget, fallback");
+  if (sol.has("branch_switches")) s.branch_switches = int(sol.integer("branch_switches"));
+  if (s.branch_switches < 0 || s.branch_switches > 10) sol.fail("branch_switches", "must be in [0, 10]");
+  sol.allowed("rtol, max_newton, max_increments, target_rtol, control, path_rtol, newton_budget, fallback, "
+              "branch_switches");
   sol.check_all_used();
 }
 
