@@ -69,7 +69,8 @@ class Shape:
     points per axis, d the dimension, L load cases per shape):
       shape_id (int), ok (bool), failure (str, "" if ok), dim (int)
       attrs           dict of the group's attributes: shape metrics (measure, isoperimetric_ratio,
-                      hausdorff_to_base, mesh_min_angle_deg, ...), dirichlet_center, dirichlet_radius
+                      hausdorff_to_base, mesh_min_angle_deg, ...), dirichlet_center, dirichlet_radius,
+                      source_file (str; directory families such as Liver: the shape's surface file)
       nodes           (n, d) float64   FE nodes (vertices first, then P2 edge midpoints), length
       cells           (m, k) int64     node ids per cell, VTK order
       dirichlet_mask  (n,) bool        node on the Dirichlet patch (u = 0)

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "hypershape/mesh/surface_file.hpp"
 #include "solver_block.hpp"
 #include "yaml_block.hpp"
 
@@ -14,30 +15,66 @@ namespace {
 
 void parse_shapes(const YamlBlock& b, const std::string& base_dir, factory::ShapeConfig& s,
                   std::int64_t& count) {
-  const long n = b.integer("count");
-  if (n < 1) b.fail("count", "must be >= 1");
-  count = n;
+  // count is read first (it is the first error to report) but a directory family may leave it
+  // out: then it is the number of files.
+  const bool has_count = b.has("count");
+  if (has_count) {
+    const long n = b.integer("count");
+    if (n < 1) b.fail("count", "must be >= 1");
+    count = n;
+  }
   const long dim = b.integer("dim");
   if (dim != 2 && dim != 3) b.fail("dim", "must be 2 or 3");
   s.dim = int(dim);
   s.base = b.text("base");
-  if (s.base != "circle" && s.base != "sphere" && s.base != "file")
-    b.fail("base", "must be circle (2D), sphere (3D) or file (3D surface), got '" + s.base + "'");
+  if (s.base != "circle" && s.base != "sphere" && s.base != "file" && s.base != "directory")
+    b.fail("base", "must be circle (2D), sphere (3D), file (3D surface) or directory (3D: one shape "
+                   "per surface file), got '" + s.base + "'");
   if ((s.base == "circle") != (s.dim == 2))
-    b.fail("base", "circle needs dim 2; sphere and file need dim 3");
-  if (s.base == "file") {
-    std::filesystem::path p = b.text("base_file");
+    b.fail("base", s.base + " needs dim " + (s.base == "circle" ? "2" : "3") +
+                       " (circle: 2D; sphere, file, directory: 3D)");
+  // Relative paths are relative to the config file's directory.
+  auto path_key = [&](const char* key) {
+    std::filesystem::path p = b.text(key);
     if (p.is_relative()) p = std::filesystem::path(base_dir) / p;
-    s.base_file = p.lexically_normal().string();
+    return p.lexically_normal().string();
+  };
+  if (s.base == "file") {
+    s.base_file = path_key("base_file");
     if (!std::filesystem::exists(s.base_file))
       b.fail("base_file", "no such file: " + s.base_file);
   } else if (b.has("base_file")) {
     b.fail("base_file", "only allowed with base: file");
   }
+  if (s.base == "directory") {
+    s.base_dir = path_key("base_dir");
+    try {
+      s.base_files = mesh::surface_files_in(s.base_dir);
+    } catch (const InputError& e) {
+      b.fail("base_dir", e.what());
+    }
+    if (s.base_files.empty())
+      b.fail("base_dir", "no surface files (.stl, .msh) in " + s.base_dir);
+    const auto n_files = std::int64_t(s.base_files.size());
+    if (!has_count) count = n_files;
+    if (count > n_files)
+      b.fail("count", std::to_string(count) + " shapes, but " + s.base_dir + " holds " +
+                          std::to_string(n_files) + " surface files (one shape per file)");
+    s.base_files.resize(std::size_t(count));  // the first `count` files, by name
+  } else if (b.has("base_dir")) {
+    b.fail("base_dir", "only allowed with base: directory");
+  }
+  if (!has_count && s.base != "directory") b.fail("count", "missing (a number is required)");
+  // A directory family is the files as they are unless steps are given; the other families
+  // are made by the steps.
   const YAML::Node steps = b.get("steps");
-  if (!steps || !steps.IsSequence() || steps.size() == 0)
-    b.fail("steps", "must be a non-empty list of [sigma, m] pairs");
-  for (std::size_t k = 0; k < steps.size(); ++k) {
+  if (s.base == "directory" ? (steps && !steps.IsSequence())
+                            : (!steps || !steps.IsSequence() || steps.size() == 0))
+    b.fail("steps", s.base == "directory"
+                        ? "must be a list of [sigma, m] pairs (none: each file as it is)"
+                        : "must be a non-empty list of [sigma, m] pairs");
+  const std::size_t n_steps = steps && steps.IsSequence() ? steps.size() : 0;
+  for (std::size_t k = 0; k < n_steps; ++k) {
     const auto& e = steps[k];
     const std::string key = "steps[" + std::to_string(k) + "]";
     if (!e.IsSequence() || e.size() != 2) b.fail(key, "must be a pair [sigma, m]");
@@ -87,7 +124,7 @@ void parse_shapes(const YamlBlock& b, const std::string& base_dir, factory::Shap
     q.allowed("min_angle_deg, min_shape");
     q.check_all_used();
   }
-  b.allowed("count, dim, base, base_file, steps, velocity_unit, nodes_per_sigma, h, dirichlet_radius, "
+  b.allowed("count, dim, base, base_file, base_dir, steps, velocity_unit, nodes_per_sigma, h, dirichlet_radius, "
             "max_turn_deg, min_feature_fraction, max_attempts, quality");
   b.check_all_used();
 }
@@ -172,9 +209,10 @@ DatasetConfig parse_dataset_text(const std::string& text, const std::string& sou
     if (!found) top.fail("preset", "unknown preset '" + c.preset + "'; presets: " + names);
     YAML::Node base = YAML::Load(found->text);
     root.remove("preset");
-    // A preset's relative paths (base_file) stay relative to the preset's directory unless the
-    // config gives its own.
-    if (!(root["shapes"] && root["shapes"]["base_file"])) base_dir = found->directory;
+    // A preset's relative paths (base_file, base_dir) stay relative to the preset's directory
+    // unless the config gives its own.
+    if (!(root["shapes"] && (root["shapes"]["base_file"] || root["shapes"]["base_dir"])))
+      base_dir = found->directory;
     root = merge(base, root);
   }
   YamlBlock top(root, source, "");
@@ -241,12 +279,23 @@ DatasetConfig parse_dataset_text(const std::string& text, const std::string& sou
   parse_petsc_block(YamlBlock(top.get("petsc"), source, "petsc"), c.petsc);
   top.allowed("preset, name, seed, shapes, loads, material, mesh, representations, split, output, solver, petsc");
   top.check_all_used();
-  // The resolved config, stored with the data: the preset merged in, paths made absolute.
+  // The resolved config, stored with the data: the preset merged in, paths made absolute, the
+  // count of a directory family written out, and its files listed (in comments: the text is
+  // the dataset's identity, so a rerun on other files is another dataset).
   if (!c.shapes.base_file.empty()) root["shapes"]["base_file"] = c.shapes.base_file;
+  std::string files;
+  if (c.shapes.base == "directory") {
+    root["shapes"]["base_dir"] = c.shapes.base_dir;
+    root["shapes"]["count"] = c.n_shapes;
+    files = "# shapes.base_dir: shape i is file i of\n";
+    for (std::size_t i = 0; i < c.shapes.base_files.size(); ++i)
+      files += "#   " + std::to_string(i) + ": " +
+               std::filesystem::path(c.shapes.base_files[i]).filename().string() + "\n";
+  }
   YAML::Emitter e;
   e << root;
   c.text = std::string("# hypershape dataset config, resolved") +
-           (c.preset.empty() ? "" : " from preset " + c.preset) + "\n" + e.c_str() + "\n";
+           (c.preset.empty() ? "" : " from preset " + c.preset) + "\n" + e.c_str() + "\n" + files;
   return c;
 }
 

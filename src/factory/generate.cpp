@@ -18,6 +18,7 @@
 #include "hypershape/factory/dataset_index.hpp"
 #include "hypershape/factory/shape_job.hpp"
 #include "hypershape/factory/shape_pipeline.hpp"
+#include "hypershape/factory/shape_set.hpp"
 #include "hypershape/io/dataset_shard.hpp"
 #include "hypershape/solver/nonlinear.hpp"
 #include "text_file.hpp"
@@ -145,7 +146,7 @@ RunReport generate(MPI_Comm comm, const config::DatasetConfig& cfg, const Genera
   std::vector<std::int64_t> todo;
   std::int64_t done_before = 0;
   // The base surface is read (and so checked) before anything is written.
-  const std::optional<geometry::Boundary> base = load_base(cfg.shapes);
+  const std::optional<geometry::Boundary> base = load_dataset_base(cfg);
   core::on_root(comm, [&] { todo = prepare_output(cfg, opt, rep.shards_total, done_before); });
   {
     std::int64_t n = std::int64_t(todo.size());

@@ -138,6 +138,7 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
       out.entry.shape.dim = d;
       out.entry.shape.rejected = e.what();
       out.entry.shape.numbers = {{"failed", 1}};
+      out.entry.shape.source_file = source_file(cfg.shapes, shape_id);
       out.loads_failed = n_loads;
       return out;
     }

@@ -4,10 +4,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <numbers>
 #include <stdexcept>
 
+#include "hypershape/core/input_error.hpp"
 #include "hypershape/core/random.hpp"
 #include "hypershape/core/timer.hpp"
 #include "hypershape/geometry/boundary_check.hpp"
@@ -116,7 +118,10 @@ geometry::Boundary draw_boundary(const ShapeConfig& c, const std::optional<geome
     // A Random3D draw needs about 9k points at h = 0.1 (measured; 35k-45k at twice the 3D
     // velocity unit, 200k at the 2D unit, whose draws all fail the checks below). One needing
     // more than 1000 / h^2 (100k at h = 0.1) is rejected before remeshing it costs seconds.
-    const std::int64_t max_points = std::max<std::int64_t>(50'000, std::int64_t(1'000.0 / (h * h)));
+    // A base surface that is already finer than h (a segmentation, say) is hardly refined:
+    // its own size must not count against the draw.
+    const std::int64_t max_points = std::max<std::int64_t>(
+        {50'000, std::int64_t(1'000.0 / (h * h)), 4 * base_surface.n_points()});
     dense = geometry::sample_surface_image(phi, base_surface, kind, h, max_points);
   } catch (const std::runtime_error& e) {
     throw Rejection{"boundary", e.what()};
@@ -146,13 +151,30 @@ geometry::Boundary draw_boundary(const ShapeConfig& c, const std::optional<geome
   return b;
 }
 
+/// A surface file normalised into [-1, 1]^3. Throws core::InputError.
+geometry::Boundary load_surface(const std::string& path) {
+  geometry::Boundary b = mesh::read_surface_file(path);
+  normalise_into_box(b);
+  return b;
+}
+
 }  // namespace
 
 std::optional<geometry::Boundary> load_base(const ShapeConfig& config) {
-  if (config.base != "file") return std::nullopt;
-  geometry::Boundary b = mesh::read_surface_file(config.base_file);
-  normalise_into_box(b);
-  return b;
+  if (config.base == "file") return load_surface(config.base_file);
+  if (config.base != "directory") return std::nullopt;
+  if (config.base_files.empty())
+    throw core::InputError(config.base_dir, "", "no surface files (.stl, .msh) in the directory");
+  // Every file is read (and so checked) now, not when its shape comes; only the first is kept:
+  // a shape reads its own file again (a few ms), so a family of large segmentations does not
+  // sit in every rank's memory.
+  for (std::size_t i = 1; i < config.base_files.size(); ++i) (void)mesh::read_surface_file(config.base_files[i]);
+  return load_surface(config.base_files.front());
+}
+
+std::string source_file(const ShapeConfig& config, std::int64_t shape_id) {
+  if (config.base != "directory") return "";
+  return std::filesystem::path(config.base_files.at(std::size_t(shape_id))).filename().string();
 }
 
 geometry::Boundary reference_base(const ShapeConfig& config,
@@ -165,13 +187,20 @@ ShapeSample make_shape(const ShapeConfig& config, const std::optional<geometry::
                        std::uint64_t seed, std::int64_t shape_id) {
   ShapeSample out;
   out.shape_id = shape_id;
+  // A directory family: this shape's own surface (base, the first file, stays the reference).
+  std::optional<geometry::Boundary> own;
+  if (config.base == "directory") {
+    own = load_surface(config.base_files.at(std::size_t(shape_id)));
+    out.source_file = source_file(config, shape_id);
+  }
+  const std::optional<geometry::Boundary>& surface = own ? own : base;
   const mesh::QualityGate gate = config.quality.min_angle_deg > 0 || config.quality.min_shape > 0
                                      ? config.quality
                                      : mesh::QualityGate::defaults(config.dim);
   for (int attempt = 0; attempt < config.max_attempts; ++attempt) {
     const double t0 = core::now_seconds();
     try {
-      out.boundary = draw_boundary(config, base, seed, shape_id, attempt, out);
+      out.boundary = draw_boundary(config, surface, seed, shape_id, attempt, out);
       const double t1 = core::now_seconds();
       mesh::BoundaryMeshOptions mopt;
       mopt.h = config.h;

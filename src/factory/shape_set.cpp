@@ -84,6 +84,7 @@ void pack(const io::ShapeRecord& r, Packer& p) {
   p.put(keys);
   p.put(values);
   p.put(r.rejected);
+  p.put(r.source_file);
 }
 
 io::ShapeRecord unpack(Unpacker& u) {
@@ -107,6 +108,7 @@ io::ShapeRecord unpack(Unpacker& u) {
     start = end + 1;
   }
   u.get(r.rejected);
+  u.get(r.source_file);
   return r;
 }
 
@@ -122,6 +124,7 @@ io::ShapeRecord to_record(const ShapeSample& s) {
   r.mesh_cells.assign(s.mesh.cells.begin(), s.mesh.cells.end());
   r.dirichlet_facets = s.dirichlet_facets;
   r.dirichlet_center.assign(s.dirichlet_center.begin(), s.dirichlet_center.begin() + 3);
+  r.source_file = s.source_file;
   const auto& m = s.metrics;
   r.numbers = {{"attempt", s.attempt},
                {"failed", 0},
@@ -146,16 +149,20 @@ io::ShapeRecord to_record(const ShapeSample& s) {
   return r;
 }
 
+std::optional<geometry::Boundary> load_dataset_base(const config::DatasetConfig& config) {
+  try {
+    return load_base(config.shapes);
+  } catch (const core::InputError& e) {
+    throw core::InputError(config.source,
+                           config.shapes.base == "directory" ? "shapes.base_dir" : "shapes.base_file",
+                           e.what());
+  }
+}
+
 std::vector<io::ShapeRecord> make_shape_range(MPI_Comm comm, const config::DatasetConfig& config,
                                               std::int64_t first, std::int64_t count) {
   const int rank = core::rank(comm), size = core::size(comm);
-  // A bad base file is an input error on every rank alike; name the config key that chose it.
-  std::optional<geometry::Boundary> base;
-  try {
-    base = load_base(config.shapes);
-  } catch (const core::InputError& e) {
-    throw core::InputError(config.source, "shapes.base_file", e.what());
-  }
+  const std::optional<geometry::Boundary> base = load_dataset_base(config);
   Packer mine;
   std::int64_t n_mine = 0;
   for (std::int64_t id = first + rank; id < first + count; id += size) {
@@ -174,6 +181,7 @@ std::vector<io::ShapeRecord> make_shape_range(MPI_Comm comm, const config::Datas
       r.dirichlet_center = {0, 0, 0};
       r.numbers = {{"failed", 1}};
       r.rejected = e.what();
+      r.source_file = source_file(config.shapes, id);
       core::log_line(MPI_COMM_SELF, core::Verbosity::normal,
                      fmt::format("[rank {}] shape {} FAILED: {}", rank, id, e.what()));
     }

@@ -98,15 +98,6 @@ double read_attr_double(hid_t obj, const char* name) {
   return v;
 }
 
-std::string read_attr_string(hid_t obj, const char* name) {
-  Id a{check_id(H5Aopen(obj, name, H5P_DEFAULT), name), H5Aclose};
-  Id type{check_id(H5Aget_type(a.id), name), H5Tclose};
-  std::string s(H5Tget_size(type.id), '\0');
-  check(H5Aread(a.id, type.id, s.data()), name);
-  while (!s.empty() && s.back() == '\0') s.pop_back();
-  return s == " " ? std::string() : s;
-}
-
 std::string hdf5_version() {
   unsigned a, b, c;
   H5get_libversion(&a, &b, &c);
@@ -184,6 +175,7 @@ void ShardWriter::add(const ShardShape& s) {
     attr_double(g.id, "shape_id", double(s.shape.shape_id));
     write_string_dataset(g.id, "rejected", s.shape.rejected);
     for (const auto& [k, v] : s.shape.numbers) attr_double(g.id, k, v);
+    if (!s.shape.source_file.empty()) attr_string(g.id, "source_file", s.shape.source_file);
     return;
   }
   write_shape_group(g.id, s.shape);

@@ -103,6 +103,15 @@ inline std::string read_string(hid_t parent, const char* name) {
   return s == " " ? std::string() : s;
 }
 
+inline std::string read_attr_string(hid_t obj, const char* name) {
+  Id a{check_id(H5Aopen(obj, name, H5P_DEFAULT), name), H5Aclose};
+  Id type{check_id(H5Aget_type(a.id), name), H5Tclose};
+  std::string s(H5Tget_size(type.id), '\0');
+  check(H5Aread(a.id, type.id, s.data()), name);
+  while (!s.empty() && s.back() == '\0') s.pop_back();
+  return s == " " ? std::string() : s;
+}
+
 inline herr_t collect_double_attr(hid_t obj, const char* name, const H5A_info_t*, void* data) {
   auto& numbers = *static_cast<std::map<std::string, double>*>(data);
   Id a{H5Aopen(obj, name, H5P_DEFAULT), H5Aclose};

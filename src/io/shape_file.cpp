@@ -23,6 +23,7 @@ void write_shape_group(hid_t g, const ShapeRecord& s) {
   attr_double(g, "shape_id", double(s.shape_id));
   for (const auto& [k, v] : s.numbers) attr_double(g, k, v);
   attr_vector(g, "dirichlet_center", s.dirichlet_center);
+  if (!s.source_file.empty()) attr_string(g, "source_file", s.source_file);
 }
 
 ShapeRecord read_shape_group(hid_t g) {
@@ -39,6 +40,7 @@ ShapeRecord read_shape_group(hid_t g) {
   H5Aiterate2(g, H5_INDEX_NAME, H5_ITER_INC, &idx, collect_double_attr, &s.numbers);
   s.shape_id = std::int64_t(s.numbers.at("shape_id"));
   s.numbers.erase("shape_id");
+  if (H5Aexists(g, "source_file") > 0) s.source_file = read_attr_string(g, "source_file");
   return s;
 }
 

@@ -74,7 +74,30 @@ std::string lower_extension(const std::string& path) {
   return ext;
 }
 
+bool is_surface_extension(const std::string& ext) { return ext == ".stl" || ext == ".msh"; }
+
 }  // namespace
+
+std::vector<std::string> surface_files_in(const std::string& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::exists(dir, ec)) throw core::InputError(dir, "", "no such directory");
+  if (!fs::is_directory(dir, ec)) throw core::InputError(dir, "", "not a directory");
+  std::vector<std::string> names;
+  try {
+    for (const fs::directory_entry& e : fs::directory_iterator(dir)) {
+      const std::string name = e.path().filename().string();
+      if (name.empty() || name.front() == '.' || !e.is_regular_file()) continue;
+      if (is_surface_extension(lower_extension(name))) names.push_back(name);
+    }
+  } catch (const fs::filesystem_error& e) {
+    throw core::InputError(dir, "", std::string("cannot list the directory: ") + e.code().message());
+  }
+  std::sort(names.begin(), names.end());
+  std::vector<std::string> paths;
+  for (const std::string& name : names) paths.push_back((fs::path(dir) / name).string());
+  return paths;
+}
 
 geometry::Boundary read_surface_file(const std::string& path) {
   namespace fs = std::filesystem;
@@ -82,7 +105,7 @@ geometry::Boundary read_surface_file(const std::string& path) {
   if (!fs::is_regular_file(path, ec))
     bad_file(path, "surface file does not exist or is not a regular file");
   const std::string ext = lower_extension(path);
-  if (ext != ".stl" && ext != ".msh")
+  if (!is_surface_extension(ext))
     bad_file(path, "unsupported surface file extension '" + ext + "' (.stl or .msh expected)");
 
   detail::ScopedModel model("surface_file");

@@ -6,7 +6,8 @@
 #  - kill -9 mid-run, then the same command: equal to the uninterrupted run, no temporary file;
 #  - a load case forced to fail is recorded (status 0, reason) and nothing stored is NaN;
 #  - bad configs and options stop before any work: message naming the key, non-zero exit,
-#    nothing written.
+#    nothing written (also a directory family's base_dir: missing, not a directory, no surface
+#    file, a broken one, too few files for count, on the wrong base, in 2D).
 # Needs HYPERSHAPE_BIN and HYPERSHAPE_SOURCE_DIR (set by CTest).
 set -u
 bin=${HYPERSHAPE_BIN:?}
@@ -135,12 +136,31 @@ expect preset          's/preset: random2d/preset: random9d/'              "pres
 expect solver          's/^seed: 7/seed: 7\nsolver: {rtol: 2}/'             "solver.rtol"
 expect control         's/^seed: 7/seed: 7\nsolver: {control: arclength}/' "solver.control"
 expect budget          's/^seed: 7/seed: 7\nsolver: {newton_budget: 0}/'   "solver.newton_budget"
+expect switches        's/^seed: 7/seed: 7\nsolver: {branch_switches: -1}/' "solver.branch_switches"
 expect petsc           's/^seed: 7/seed: 7\npetsc: {pc_type: [lu]}/'       "petsc.pc_type"
 expect shapes_h        's/h: 0.1/h: -1/'                                   "shapes.h"
 expect surface_missing 's/preset: random2d/preset: random3d/; s/shapes: {count: 5, h: 0.1}/shapes: {count: 5, base: file, base_file: nowhere.stl}/' "shapes.base_file"
 printf 'solid x\nendsolid x\n' > "$work/empty.stl"
 expect surface_empty   "s|preset: random2d|preset: random3d|; s|shapes: {count: 5, h: 0.1}|shapes: {count: 5, base: file, base_file: $work/empty.stl}|" "empty.stl"
 expect not_yaml        's/^shapes: {/shapes: {[/'                          "YAML"
+# A directory family (base: directory, one shape per surface file of base_dir).
+mkdir -p "$work/two_livers" "$work/no_surfaces" "$work/broken_dir"
+cp "$src/configs/surfaces/livers/liver_000.stl" "$work/two_livers/a.stl"
+cp "$src/configs/surfaces/livers/liver_001.stl" "$work/two_livers/b.stl"
+echo "not a surface" > "$work/no_surfaces/readme.txt"
+cp "$src/configs/surfaces/livers/liver_000.stl" "$work/broken_dir/a.stl"
+cp "$work/empty.stl" "$work/broken_dir/b.stl"
+liver() { echo "s|preset: random2d|preset: liver|; s|shapes: {count: 5, h: 0.1}|shapes: {$1}|"; }
+expect dir_missing     "$(liver "base_dir: $work/nowhere")"                "shapes.base_dir: $work/nowhere: no such directory"
+expect dir_is_file     "$(liver "base_dir: $work/empty.stl")"              "shapes.base_dir: $work/empty.stl: not a directory"
+expect dir_no_surfaces "$(liver "base_dir: $work/no_surfaces")"            "shapes.base_dir: no surface files"
+expect dir_broken_file "$(liver "base_dir: $work/broken_dir")"             "shapes.base_dir: $work/broken_dir/b.stl"
+expect dir_count       "$(liver "count: 3, base_dir: $work/two_livers")"   "shapes.count: 3 shapes, but"
+expect dir_steps_type  "$(liver "base_dir: $work/two_livers, steps: 0.2")" "shapes.steps"
+expect dir_wrong_base  "s|preset: random2d|preset: random3d|; s|shapes: {count: 5, h: 0.1}|shapes: {count: 2, base_dir: $work/two_livers}|" \
+                       "shapes.base_dir: only allowed with base: directory"
+expect dir_in_2d       "s|shapes: {count: 5, h: 0.1}|shapes: {count: 2, base: directory, base_dir: $work/two_livers}|" \
+                       "shapes.base: directory needs dim 3"
 expect task_index      's/^seed: 7/seed: 7/'                               "--task-index" --task-index 3 --task-count 3
 expect group_size      's/^seed: 7/seed: 7/'                               "--group-size" --group-size 4
 mkdir -p "$work/readonly" && chmod 500 "$work/readonly"

@@ -71,5 +71,9 @@ expect missing_surface  's/dim: 2/dim: 3/; s/base: circle/base: file\n  base_fil
 printf 'solid x\nendsolid x\n' > "$work/empty.stl"
 expect empty_surface    "s|dim: 2|dim: 3|; s|base: circle|base: file\n  base_file: $work/empty.stl|" "empty.stl"
 expect not_yaml         's/^shapes:/shapes: [/'                        "YAML"
+mkdir -p "$work/broken_dir"
+cp "$src/configs/surfaces/livers/liver_000.stl" "$work/broken_dir/a.stl"
+cp "$work/empty.stl" "$work/broken_dir/b.stl"
+expect broken_in_dir    "s|dim: 2|dim: 3|; s|base: circle|base: directory\n  base_dir: $work/broken_dir|" "shapes.base_dir: $work/broken_dir/b.stl"
 echo "$passes passed, $fails failed"
 [ "$fails" -eq 0 ]

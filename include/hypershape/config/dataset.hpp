@@ -8,10 +8,13 @@
 /// name: random2d
 /// seed: 1001                      # every random draw is a function of (seed, shape id, load id)
 /// shapes:
-///   count: 1000
+///   count: 1000                   # (base: directory: at most, and by default, its file count)
 ///   dim: 2                        # 2 | 3
 ///   base: circle                  # circle (2D) | sphere (3D) | file (3D, + base_file: PATH)
-///   steps: [[0.2, 4], [0.1, 1]]   # (sigma, m) per deformation, coarse first
+///                                 # | directory (3D, + base_dir: DIR: shape i = i-th surface
+///                                 #   file of DIR by name, .stl/.msh)
+///   steps: [[0.2, 4], [0.1, 1]]   # (sigma, m) per deformation, coarse first (base: directory:
+///                                 # optional, none = each file as it is)
 ///   velocity_unit: 0.04           # velocity std = m * velocity_unit (optional; 0.04 2D, 0.0125 3D)
 ///   nodes_per_sigma: 6            # velocity grid resolution (optional; 6 in 2D, 3 in 3D)
 ///   h: 0.04                       # element size, in the normalised box [-1, 1]^d
@@ -95,8 +98,10 @@ struct Preset {
 };
 const std::vector<Preset>& presets();
 
-/// Parses and validates a dataset config; relative paths (base_file) are resolved against the
-/// file's directory. Throws core::InputError.
+/// Parses and validates a dataset config; relative paths (base_file, base_dir) are resolved
+/// against the file's directory (a preset's against configs/presets/). A base_dir is listed
+/// here (it must hold enough surface files); the files themselves are read by
+/// factory::load_base. Throws core::InputError.
 DatasetConfig parse_dataset_file(const std::string& path);
 DatasetConfig parse_dataset_text(const std::string& text, const std::string& source,
                                  const std::string& base_dir = ".");

@@ -22,8 +22,13 @@ namespace hypershape::factory {
 struct ShapeConfig {
   std::string name;                      ///< preset name, for reports
   int dim = 2;
-  std::string base = "circle";           ///< circle | sphere | file
+  std::string base = "circle";           ///< circle | sphere | file | directory
   std::string base_file;                 ///< surface file (STL / .msh) when base == file
+  /// base == directory: shape i is the surface file base_files[i] (the first `count` surface
+  /// files of base_dir, sorted by name; see mesh::surface_files_in), each normalised into
+  /// [-1, 1]^3 and deformed by `deformation` (usually no step: the file as it is, remeshed).
+  std::string base_dir;
+  std::vector<std::string> base_files;
   geometry::DeformationSpec deformation;  ///< steps, velocity unit, grid resolution
   double h = 0.05;                       ///< target element size (normalised units)
   double dirichlet_radius = 0.5;         ///< r of the Dirichlet patch; 0: no patch
@@ -53,11 +58,15 @@ struct ShapeSample {
   geometry::ShapeMetrics metrics;
   mesh::MeshQuality quality;
   std::vector<RejectedDraw> rejected;
+  std::string source_file;                  ///< base == directory: its file's name (no directory)
   double seconds_draw = 0, seconds_mesh = 0, seconds_metrics = 0;
 };
 
-/// Loads the base surface of `config` (base == file) normalised into [-1, 1]^3; nullopt for
-/// circle/sphere. Throws core::InputError for a bad file.
+/// Loads the base surface of `config` normalised into [-1, 1]^3 (any units): base == file, the
+/// file; base == directory, the first file (the metrics' reference, as the seed paper compares
+/// its livers with the first), after reading every file of the family so that a bad one stops
+/// the run before any work. nullopt for circle/sphere. Throws core::InputError naming the bad
+/// file. Not collective.
 std::optional<geometry::Boundary> load_base(const ShapeConfig& config);
 
 /// The base boundary the metrics compare against: the unit circle / sphere, or the loaded
@@ -65,8 +74,13 @@ std::optional<geometry::Boundary> load_base(const ShapeConfig& config);
 geometry::Boundary reference_base(const ShapeConfig& config,
                                   const std::optional<geometry::Boundary>& loaded);
 
-/// Draws shape `shape_id` of the family. `base` is load_base(config). Throws
-/// std::runtime_error if max_attempts draws all fail (with every reason in the message).
+/// The name (without directory) of the surface file shape `shape_id` is made of (base ==
+/// directory), or "" for the other families.
+std::string source_file(const ShapeConfig& config, std::int64_t shape_id);
+
+/// Draws shape `shape_id` of the family. `base` is load_base(config); a directory family reads
+/// its shape's own file here. Throws std::runtime_error if max_attempts draws all fail (with
+/// every reason in the message).
 ShapeSample make_shape(const ShapeConfig& config, const std::optional<geometry::Boundary>& base,
                        std::uint64_t seed, std::int64_t shape_id);
 

@@ -5,6 +5,7 @@
 #include <mpi.h>
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "hypershape/config/dataset.hpp"
@@ -15,6 +16,11 @@ namespace hypershape::factory {
 
 /// The flat record of a shape (for files and for sending between ranks).
 io::ShapeRecord to_record(const ShapeSample& s);
+
+/// load_base(config.shapes), with a bad surface file reported as an input error of the config
+/// (its file and the key that chose the surface: shapes.base_file or shapes.base_dir). Raised
+/// on every rank alike. Not collective.
+std::optional<geometry::Boundary> load_dataset_base(const config::DatasetConfig& config);
 
 /// Shapes [first, first + count): rank r draws the ids with (id - first) % size == r and prints
 /// a progress line per shape; rank 0 returns all records in id order, other ranks an empty

@@ -9,7 +9,8 @@
 ///       attempt, measure, boundary_measure, isoperimetric_ratio, hausdorff_to_base,
 ///       min_local_feature_size, min_exterior_gap, n_boundary_facets, n_vertices, n_cells,
 ///       mesh_min_angle_deg, mesh_min_shape, dirichlet_center (3), dirichlet_radius,
-///       seconds_draw, seconds_mesh, seconds_metrics, n_rejected
+///       seconds_draw, seconds_mesh, seconds_metrics, n_rejected;
+///       source_file (string, only for a shape made of a file of a directory family)
 ///     boundary/points    n x dim float64   boundary point i is mesh vertex i
 ///     boundary/facets    m x dim int32     segments (2D, counter-clockwise) / outward triangles
 ///     mesh/nodes         N x dim float64
@@ -36,6 +37,7 @@ struct ShapeRecord {
   std::vector<double> dirichlet_center;  ///< 3
   std::map<std::string, double> numbers;  ///< scalar attributes
   std::string rejected;                   ///< one line per redrawn attempt
+  std::string source_file;                ///< the surface file it was made of (directory family), or ""
 };
 
 /// Writes all shapes to `path`. Not collective. Throws std::runtime_error on I/O failure and

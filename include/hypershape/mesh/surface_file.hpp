@@ -1,6 +1,7 @@
 #pragma once
 /// Reading a closed triangle surface (the boundary of a 3D shape) from a file, through gmsh.
 #include <string>
+#include <vector>
 
 #include "hypershape/geometry/boundary.hpp"
 
@@ -20,5 +21,13 @@ namespace hypershape::mesh {
 /// message carries check_boundary's reason). gmsh stays usable after a failed read. Uses the
 /// open GmshSession or opens one for the call; not collective (call on one rank).
 geometry::Boundary read_surface_file(const std::string& path);
+
+/// The surface files directly in directory `dir` (what read_surface_file takes: extension .stl
+/// or .msh, any case; regular files or links to them; hidden names, starting with '.', are
+/// skipped), as paths `dir`/NAME sorted by NAME in byte order (so liver_010 follows liver_009
+/// but liver_10 precedes liver_9: number files with leading zeros). Other files are ignored.
+/// Empty if there is none. Throws core::InputError naming `dir` when it does not exist, is not a
+/// directory or cannot be listed. Not collective.
+std::vector<std::string> surface_files_in(const std::string& dir);
 
 }  // namespace hypershape::mesh

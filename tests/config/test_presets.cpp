@@ -1,0 +1,98 @@
+// The dataset presets embedded in the binary: the paper's eight (Table 1) are there, each parses
+// by name as it does from its file, and the directory presets (liver, one_liver) resolve to the
+// shipped stand-in surfaces: one shape per file in name order, no deformation.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <filesystem>
+#include <set>
+#include <string>
+
+#include "hypershape/config/dataset.hpp"
+#include "hypershape/core/input_error.hpp"
+#include "hypershape/mesh/surface_file.hpp"
+
+using namespace hypershape;
+
+namespace {
+
+config::DatasetConfig by_name(const std::string& text) {
+  return config::parse_dataset_text(text, "<test>");
+}
+
+std::string shipped_livers() { return std::string(HS_SOURCE_DIR) + "/configs/surfaces/livers"; }
+
+}  // namespace
+
+TEST_CASE("the paper's eight presets are embedded and parse by name as from their files",
+          "[config][presets]") {
+  std::set<std::string> names;
+  for (const auto& p : config::presets()) {
+    INFO(p.name);
+    names.insert(p.name);
+    const auto a = by_name(std::string("preset: ") + p.name + "\n");
+    const auto b = config::parse_dataset_file(std::string(p.directory) + "/" + p.name + ".yaml");
+    CHECK(a.name == p.name);
+    CHECK(a.n_shapes == b.n_shapes);
+    CHECK(a.loads.count == b.loads.count);
+    CHECK(a.shapes.base_file == b.shapes.base_file);
+    CHECK(a.shapes.base_files == b.shapes.base_files);
+  }
+  for (const char* n : {"random2d", "easy_random2d", "ood_random2d", "one_random2d", "random3d",
+                        "aug_liver", "liver", "one_liver"})
+    CHECK(names.count(n) == 1);
+}
+
+TEST_CASE("liver and one_liver: one shape per shipped surface file, no deformation",
+          "[config][presets]") {
+  const std::vector<std::string> files = mesh::surface_files_in(shipped_livers());
+  REQUIRE(files.size() >= 2);
+  CHECK(std::is_sorted(files.begin(), files.end()));
+
+  const auto liver = by_name("preset: liver\n");
+  // Table 1: 100 load cases per shape, no deformation; 3D datasets: r 0.4, gamma 0.1, grid 64.
+  CHECK(liver.n_shapes == std::int64_t(files.size()));  // count: the number of files
+  CHECK(liver.shapes.base == "directory");
+  CHECK(liver.shapes.base_files == files);
+  CHECK(liver.shapes.deformation.steps.empty());
+  CHECK(liver.shapes.dim == 3);
+  CHECK(liver.shapes.dirichlet_radius == 0.4);
+  CHECK(liver.loads.count == 100);
+  CHECK(liver.loads.gamma == 0.1);
+  CHECK(liver.representations.grid_size == 64);
+  // The resolved config (the dataset's identity) writes the count and lists the files.
+  CHECK(liver.text.find("count: " + std::to_string(files.size())) != std::string::npos);
+  CHECK(liver.text.find("0: liver_000.stl") != std::string::npos);
+
+  const auto one = by_name("preset: one_liver\n");
+  CHECK(one.n_shapes == 1);
+  CHECK(one.loads.count == 10000);
+  REQUIRE(one.shapes.base_files.size() == 1);
+  CHECK(one.shapes.base_files[0] == files[0]);
+
+  // count < files takes the first `count` by name; steps may deform each file.
+  const auto two = by_name("preset: liver\nshapes: {count: 2, steps: [[0.2, 1]]}\n");
+  CHECK(two.n_shapes == 2);
+  CHECK(two.shapes.base_files == std::vector<std::string>(files.begin(), files.begin() + 2));
+  CHECK(two.shapes.deformation.steps.size() == 1);
+}
+
+TEST_CASE("a directory family's keys are checked", "[config][presets]") {
+  auto error_of = [](const std::string& text) {
+    try {
+      (void)by_name(text);
+    } catch (const core::InputError& e) {
+      return e.key() + " | " + e.what();
+    }
+    return std::string("no error");
+  };
+  CHECK_THAT(error_of("preset: liver\nshapes: {count: 1000}\n"), Catch::StartsWith("shapes.count"));
+  CHECK_THAT(error_of("preset: liver\nshapes: {base_dir: /nonexistent/livers}\n"),
+             Catch::StartsWith("shapes.base_dir") && Catch::Contains("no such directory"));
+  CHECK_THAT(error_of("preset: random3d\nshapes: {base_dir: " + shipped_livers() + "}\n"),
+             Catch::StartsWith("shapes.base_dir") && Catch::Contains("only allowed with base: directory"));
+  CHECK_THAT(error_of("preset: random2d\nshapes: {base: directory, base_dir: " + shipped_livers() + "}\n"),
+             Catch::StartsWith("shapes.base"));
+  CHECK_THAT(error_of("preset: liver\nshapes: {base_file: x.stl}\n"), Catch::StartsWith("shapes.base_file"));
+  CHECK_THAT(error_of("preset: random3d\nshapes: {count: null}\n"), Catch::StartsWith("shapes.count"));
+}
