@@ -97,7 +97,8 @@ bool all_finite(const std::vector<double>& v) {
 }  // namespace
 
 ShapeProblem make_shape_problem(MPI_Comm group, const config::DatasetConfig& cfg,
-                                const ShapeSample& shape, const LoadCase& first) {
+                                const ShapeSample& shape, const LoadCase& first,
+                                std::optional<physics::SpaceOptions> space) {
   const int d = cfg.shapes.dim;
   std::vector<physics::EffectPtr> effects;
   effects.push_back(physics::make_neo_hookean(cfg.material.E, cfg.material.nu));
@@ -111,7 +112,7 @@ ShapeProblem make_shape_problem(MPI_Comm group, const config::DatasetConfig& cfg
   out.traction = gt.get();
   effects.push_back(std::move(gt));
   out.problem = std::make_unique<physics::Problem>(group, shape.mesh, std::move(effects),
-                                                   physics::SpaceOptions{cfg.degree});
+                                                   space.value_or(physics::SpaceOptions{cfg.degree}));
   return out;
 }
 

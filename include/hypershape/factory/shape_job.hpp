@@ -37,9 +37,10 @@ struct ShapeProblem {
   std::unique_ptr<physics::Problem> problem;
   physics::GaussianTraction* traction = nullptr;  ///< owned by `problem`
 };
-/// Collective over `group`.
+/// Collective over `group`. `space`: the discretisation (default: the config's degree).
 ShapeProblem make_shape_problem(MPI_Comm group, const config::DatasetConfig& config,
-                                const ShapeSample& shape, const LoadCase& first);
+                                const ShapeSample& shape, const LoadCase& first,
+                                std::optional<physics::SpaceOptions> space = std::nullopt);
 
 /// Collective over `group`. `base` is load_base(config.shapes). `on_load(converged)` runs on
 /// every rank of the group after each load case (progress). Never throws for a shape or a

@@ -1,0 +1,100 @@
+#!/usr/bin/env bash
+# The accuracy/time study end to end in its tiny version (drivers/study_accuracy.cpp --tiny: the
+# unit disk, P1 at h 0.16/0.08/0.04 and P2 at 0.16/0.08 against a P2 h 0.02 reference, one
+# load case, one repeat), then the plot script. Asserts: every setting converged with finite
+# errors; the error falls as h falls for P1 and for P2; P2 beats P1 at the same h; the
+# reference's Richardson estimate (and its observed order) is reported and finite; the C++
+# metrics agree with scripts/hypershape_data.py's rel_l2 / rel_h1 to round-off on the dumped
+# arrays; the JSON, the markdown table and the Pareto PNG exist.
+# Needs HYPERSHAPE_BIN (the study binary sits beside it) and HYPERSHAPE_SOURCE_DIR (set by CTest).
+set -u
+bin_dir=$(dirname "${HYPERSHAPE_BIN:?}")
+src=${HYPERSHAPE_SOURCE_DIR:?}
+study="$bin_dir/study_accuracy"
+[ -x "$study" ] || { echo "FAIL: no $study (build the study_accuracy target)"; exit 1; }
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
+
+start=$(date +%s)
+if ! "$study" --tiny --out "$work/study.json" --dump "$work/dump.json" > "$work/table.md" 2> "$work/progress.txt"; then
+  echo "FAIL: study_accuracy --tiny"; cat "$work/progress.txt"; exit 1
+fi
+echo "study_accuracy --tiny: $(( $(date +%s) - start )) s"
+cat "$work/progress.txt"
+grep -q "reference" "$work/progress.txt" || { echo "FAIL: no progress lines"; exit 1; }
+grep -q "| setting |" "$work/table.md" || { echo "FAIL: no markdown table printed"; exit 1; }
+
+if ! /usr/bin/python3 "$src/scripts/plot_accuracy.py" "$work/study.json" --fig-dir "$work/fig" --suffix _tiny \
+     --table "$work/study.md" > /dev/null; then
+  echo "FAIL: plot_accuracy.py"; exit 1
+fi
+
+PYTHONPATH="$src/scripts" /usr/bin/python3 - "$work" <<'PY'
+import json, math, os, sys
+import numpy as np
+import hypershape_data as hd
+
+work = sys.argv[1]
+s = json.load(open(f"{work}/study.json"))
+assert s["mode"] == "tiny", s["mode"]
+assert s["machine"]["nproc"] >= 1 and s["machine"].get("cpu_model"), s["machine"]
+(sc,) = s["scenes"]
+assert sc["name"] == "disk" and sc["dim"] == 2 and "error" not in sc, sc.get("error")
+ref = sc["reference"]
+rich = ref["richardson"][0]
+for k in ("l2", "h1", "alpha"):
+    e = rich[k]["estimate"]
+    assert e is not None and math.isfinite(e) and e > 0, (k, rich[k])
+    assert rich[k]["order_observed"] is not None, (k, rich[k])
+print(f"reference P2 h {ref['h']}: {ref['dofs']} DoFs, Richardson estimate of its own error: "
+      f"L2 {rich['l2']['estimate']:.2e} (order {rich['l2']['order_observed']:.2f}), "
+      f"H1 {rich['h1']['estimate']:.2e}, alpha {rich['alpha']['estimate']:.2e}")
+assert ref["richardson_l2_mean"] is not None
+
+err = {}
+for r in sc["results"]:
+    st = r["setting"]
+    assert "error" not in r, (st["name"], r.get("error"))
+    for lo in r["loads"]:
+        assert lo["converged"], (st["name"], lo["reason"])
+        for k in ("rel_l2", "rel_h1", "alpha_err", "seconds"):
+            assert lo[k] is not None and math.isfinite(lo[k]) and lo[k] >= 0, (st["name"], k, lo[k])
+        assert lo["rel_l2"] > 0 and lo["rel_h1"] > 0, st["name"]
+    if st["group"] == "mesh":
+        err[(st["degree"], st["h"])] = (r["summary"]["rel_l2"], r["summary"]["rel_h1"])
+print("mesh settings (degree, h): (rel L2, rel H1):", err)
+for p, hs in ((1, [0.16, 0.08, 0.04]), (2, [0.16, 0.08])):
+    for coarse, fine in zip(hs, hs[1:]):
+        for m in (0, 1):
+            assert err[(p, fine)][m] < err[(p, coarse)][m], f"P{p}: error does not fall from h {coarse} to {fine}: {err}"
+for h in (0.16, 0.08):
+    assert err[(2, h)][0] < err[(1, h)][0], f"P2 is not more accurate than P1 at h {h}: {err}"
+defaults = [r for r in sc["results"] if r["setting"]["is_default"]]
+assert len(defaults) == 1 and defaults[0]["setting"]["name"] == "P1 h0.04", [r["setting"]["name"] for r in defaults]
+tight = [r for r in sc["results"] if r["setting"]["group"] == "tolerance"][0]
+assert defaults[0]["loads"][0]["solver_l2"] is not None and defaults[0]["loads"][0]["solver_l2"] < 1e-2
+
+# One implementation per metric: the C++ values equal the Python readers' on the same arrays.
+d = json.load(open(f"{work}/dump.json"))
+dim, k = d["dim"], d["nodes_per_cell"]
+nodes = np.array(d["nodes"]).reshape(-1, dim)
+cells = np.array(d["cells"]).reshape(-1, k)
+u = np.array(d["u_ref"]).reshape(-1, dim)
+uh = np.array(d["u_hat"]).reshape(-1, dim)
+l2, h1 = hd.rel_l2(u, uh), hd.rel_h1(u, uh, nodes, cells)
+assert abs(l2 - d["rel_l2"]) <= 1e-10 * l2, (l2, d["rel_l2"])
+assert abs(h1 - d["rel_h1"]) <= 1e-10 * h1, (h1, d["rel_h1"])
+print(f"C++ vs hypershape_data ({d['setting']}): rel L2 {d['rel_l2']:.12e} vs {l2:.12e}, "
+      f"rel H1 {d['rel_h1']:.12e} vs {h1:.12e}")
+
+png = f"{work}/fig/accuracy_pareto_2d_tiny.png"
+assert os.path.getsize(png) > 10000, png
+assert open(png, "rb").read(8) == b"\x89PNG\r\n\x1a\n"
+md = open(f"{work}/study.md").read()
+assert "Pareto front" in md and "P1 h0.04 **(default)**" in md, md[:2000]
+print("plot and table written")
+PY
+rc=$?
+[ $rc -eq 0 ] && echo "PASS" || echo "FAIL"
+exit $rc
