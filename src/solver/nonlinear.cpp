@@ -264,8 +264,9 @@ TargetResult NonlinearSolver::solve_for_target(double target) {
   const double start = core::now_seconds();
   TargetResult t = opt_.control == Control::displacement ? follow_path(target, start)
                                                           : search_target(target, start);
+  // (t.solves == 0: the path never started, e.g. no tangent at the initial state: no branch.)
   for (int k = 0; k < opt_.branch_switches && opt_.control == Control::displacement && !t.converged &&
-                  target > 0 && t.newton_iterations < opt_.newton_budget;
+                  target > 0 && t.solves > 0 && t.newton_iterations < opt_.newton_budget;
        ++k)
     switch_branch(target, start, k, t);
   if (opt_.control == Control::displacement && !t.converged && opt_.fallback && target > 0) {
@@ -534,7 +535,7 @@ bool NonlinearSolver::minimise(double s, int& its, std::string& why) {
 }
 
 void NonlinearSolver::switch_branch(double target, double start, int attempt, TargetResult& t) {
-  int its = 0;
+  int its = t.newton_iterations;  // the Newton budget counts the whole target solve
   std::string why;
   if (attempt == 0) {
     HS_PETSC(VecCopy(u_, v0_));
@@ -566,8 +567,8 @@ void NonlinearSolver::switch_branch(double target, double start, int attempt, Ta
   }
   if (ok) ok = minimise(s_, its, why);
   const std::string before = t.reason;
-  t.newton_iterations += its;
-  t.recovery_iterations += its;
+  t.recovery_iterations += its - t.newton_iterations;
+  t.newton_iterations = its;
   if (!ok) {
     t.reason = before + "; branch switch failed: " + why;
     return;
