@@ -36,6 +36,7 @@
 #include <string>
 #include <vector>
 
+#include "driver_support.hpp"
 #include "hypershape/config/dataset.hpp"
 #include "hypershape/core/error.hpp"
 #include "hypershape/core/petsc_handle.hpp"
@@ -293,29 +294,10 @@ void print_table(std::ostream& os, const std::vector<PresetRecord>& recs) {
   }
 }
 
-void write_json_atomic(const std::string& path, const json& j) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp);
-    f << j.dump(2) << "\n";
-  }
-  fs::rename(tmp, path);
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<char*> ours{argv[0]}, petsc{argv[0]};
-  {
-    bool after = false;
-    for (int i = 1; i < argc; ++i) {
-      if (!after && std::string(argv[i]) == "--") {
-        after = true;
-        continue;
-      }
-      (after ? petsc : ours).push_back(argv[i]);
-    }
-  }
+  auto [ours, petsc] = hs::drivers::split_at_dashes(argc, argv);
   Settings set;
   CLI::App app{"Per-stage timings of random shapes (draw, mesh, signed-distance grid, patch "
                "distance) for dataset presets. Arguments after \"--\" go to PETSc."};
@@ -330,6 +312,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }
+  if (!hs::drivers::output_writable(set.json_path, "--json")) return 2;
   if (set.presets.empty()) {
     for (const char* n : {"random2d", "easy_random2d", "ood_random2d", "one_random2d", "random3d",
                           "aug_liver"})
@@ -390,11 +373,11 @@ int main(int argc, char** argv) {
       out["presets"].push_back(to_json(rec));
       out["total_seconds"] = hs::core::now_seconds() - t_all;
       out["machine"]["load_average_end"] = load_average();
-      if (!set.json_path.empty()) write_json_atomic(set.json_path, out);
+      if (!set.json_path.empty()) hs::drivers::write_json_atomic(set.json_path, out, "--json");
     }
     out["total_seconds"] = hs::core::now_seconds() - t_all;
     out["machine"]["load_average_end"] = load_average();
-    if (!set.json_path.empty()) write_json_atomic(set.json_path, out);  // skips after the last run
+    if (!set.json_path.empty()) hs::drivers::write_json_atomic(set.json_path, out, "--json");  // skips after the last run
     print_table(std::cout, recs);
     for (const auto& s : out["skipped"])
       std::cout << fmt::format("skipped {}: {}\n", s["file"].get<std::string>(),

@@ -43,6 +43,7 @@
 #include <thread>
 #include <vector>
 
+#include "driver_support.hpp"
 #include "hypershape/core/error.hpp"
 #include "hypershape/core/petsc_handle.hpp"
 #include "hypershape/core/timer.hpp"
@@ -523,31 +524,10 @@ void add_checks(CaseRecord& c) {
                                   last(c, "full_increments"), last(c, "full_failed_increments")));
 }
 
-void write_json_atomic(const std::string& path, const json& j) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp);
-    if (!f) throw hs::core::InputError(path, "--json", "cannot open for writing");
-    f << j.dump(2) << "\n";
-  }
-  std::filesystem::rename(tmp, path);
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
-  // Split: ours before "--", PETSc's after.
-  std::vector<char*> ours{argv[0]}, petsc{argv[0]};
-  {
-    bool after = false;
-    for (int i = 1; i < argc; ++i) {
-      if (!after && std::string(argv[i]) == "--") {
-        after = true;
-        continue;
-      }
-      (after ? petsc : ours).push_back(argv[i]);
-    }
-  }
+  auto [ours, petsc] = hs::drivers::split_at_dashes(argc, argv);
   Settings set;
   CLI::App app{"Per-phase timings of the disk/ball Neo-Hookean solves. Arguments after \"--\" go "
                "to PETSc (e.g. -- -log_view -pc_type lu)."};
@@ -570,6 +550,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }
+  if (!hs::drivers::output_writable(set.json_path, "--json")) return 2;
 
   int petsc_argc = int(petsc.size());
   char** petsc_argv = petsc.data();
@@ -633,7 +614,7 @@ int main(int argc, char** argv) {
       recs.push_back(rec);
       out["cases"].push_back(to_json(rec));
       out["total_seconds"] = hs::core::now_seconds() - t_all;
-      if (root && !set.json_path.empty()) write_json_atomic(set.json_path, out);
+      if (root && !set.json_path.empty()) hs::drivers::write_json_atomic(set.json_path, out, "--json");
     }
     if (root) {
       print_tables(std::cout, recs);

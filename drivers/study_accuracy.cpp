@@ -66,6 +66,7 @@
 #include <string>
 #include <vector>
 
+#include "driver_support.hpp"
 #include "hypershape/config/dataset.hpp"
 #include "hypershape/core/error.hpp"
 #include "hypershape/core/petsc_handle.hpp"
@@ -709,18 +710,6 @@ json setting_json(const Setting& s) {
 
 // ---- output ---------------------------------------------------------------------------------
 
-void write_json_atomic(const std::string& path, const json& j) {
-  const std::filesystem::path p(path);
-  if (p.has_parent_path()) std::filesystem::create_directories(p.parent_path());
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp);
-    if (!f) throw std::runtime_error("cannot write " + tmp);
-    f << j.dump(1) << "\n";
-  }
-  std::filesystem::rename(tmp, path);
-}
-
 std::string fmt_e(const json& v) { return v.is_null() ? "-" : fmt::format("{:.2e}", v.get<double>()); }
 std::string fmt_s(const json& v) {
   if (v.is_null()) return "-";
@@ -765,17 +754,7 @@ double mean_of(const std::vector<double>& v) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<char*> ours{argv[0]}, petsc{argv[0]};
-  {
-    bool after = false;
-    for (int i = 1; i < argc; ++i) {
-      if (!after && std::string(argv[i]) == "--") {
-        after = true;
-        continue;
-      }
-      (after ? petsc : ours).push_back(argv[i]);
-    }
-  }
+  auto [ours, petsc] = hs::drivers::split_at_dashes(argc, argv);
   Args a;
   CLI::App app{"The accuracy/time study (docs/ACCURACY.md). Arguments after \"--\" go to PETSc."};
   auto* tiny = app.add_flag("--tiny", a.tiny, "CI version: the disk, P1/P2 at coarse h, a coarse reference, 1 load case");
@@ -803,6 +782,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }
+  if (!hs::drivers::output_writable(a.out, "--out") || !hs::drivers::output_writable(a.dump, "--dump")) return 2;
   if (a.repeats < 0) a.repeats = a.tiny ? 1 : 3;
   if (a.ref_h2d < 0) a.ref_h2d = 0.02;
   if (a.ref_h3d < 0) a.ref_h3d = 0.2;
@@ -1104,7 +1084,7 @@ int main(int argc, char** argv) {
                           {"u_hat", at_ref[l]},
                           {"rel_l2", e2},
                           {"rel_h1", e1}};
-                  write_json_atomic(a.dump, dj);
+                  hs::drivers::write_json_atomic(a.dump, dj, "--dump", 1);
                   dumped = true;
                 }
               }
@@ -1148,7 +1128,7 @@ int main(int argc, char** argv) {
       out["scenes"].push_back(sc);
       out["seconds_total"] = hs::core::now_seconds() - t_all;
       out["load_average_end"] = load_average();
-      write_json_atomic(a.out, out);
+      hs::drivers::write_json_atomic(a.out, out, "--out", 1);
     }
     print_table(std::cout, out);
     std::cout << fmt::format("\ntotal {:.1f} s on {} ({} cores, {}); load average at start {}, end {}\n",

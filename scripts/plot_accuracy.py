@@ -27,7 +27,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-# The seed paper's Table 2 (tab:in-dist, /work/shared/seed/000_b46563e6433f889f.txt): mean
+# The seed paper's Table 2 (tab:in-dist, in-distribution results): mean
 # relative L2 error of the best and the worst model per dataset.
 TABLE2 = {
     2: {"OneRandom2D": (0.0057, 0.0191), "EasyRandom2D": (0.0293, 0.0965), "Random2D": (0.1180, 0.2921)},

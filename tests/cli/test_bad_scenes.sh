@@ -1,11 +1,7 @@
 #!/usr/bin/env bash
 # Bad scene files fail with a message naming the file and the key, a non-zero exit, and no
 # output file. Needs HYPERSHAPE_BIN (set by CTest).
-set -u
-bin=${HYPERSHAPE_BIN:?}
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0 passes=0
+. "$(dirname "$0")/lib.sh"
 
 good() {
   cat <<'YAML'
@@ -54,5 +50,4 @@ good > "$work/ok.yaml"
 if "$bin" solve "$work/ok.yaml" -o "$work/no/such/dir/out.h5" 2>/dev/null; then
   echo "FAIL unwritable output accepted"; fails=$((fails+1)); else echo "ok   unwritable output"; passes=$((passes+1)); fi
 
-echo "$passes passed, $fails failed"
-[ "$fails" -eq 0 ]
+finish

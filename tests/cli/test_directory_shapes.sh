@@ -9,14 +9,7 @@
 # The presets (liver, one_liver) are checked in tests/config/test_presets.cpp.
 # Bad directory configs are in test_generate.sh and test_shapes.sh. Needs HYPERSHAPE_BIN and
 # HYPERSHAPE_SOURCE_DIR (set by CTest).
-set -u
-bin=${HYPERSHAPE_BIN:?}
-src=${HYPERSHAPE_SOURCE_DIR:?}
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0 passes=0
-fail() { echo "FAIL: $*"; fails=$((fails+1)); }
-ok() { echo "ok   $*"; passes=$((passes+1)); }
+. "$(dirname "$0")/lib.sh"
 
 # Two surfaces whose names sort against the shipped order (liver_001 becomes shape 0), one with
 # an upper-case extension; a text file, a hidden broken surface and a directory named like a
@@ -89,5 +82,4 @@ else
   fail "shapes on 2 ranks exited non-zero"
 fi
 
-echo "$passes passed, $fails failed"
-[ "$fails" -eq 0 ]
+finish

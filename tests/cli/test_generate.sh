@@ -9,14 +9,7 @@
 #    nothing written (also a directory family's base_dir: missing, not a directory, no surface
 #    file, a broken one, too few files for count, on the wrong base, in 2D).
 # Needs HYPERSHAPE_BIN and HYPERSHAPE_SOURCE_DIR (set by CTest).
-set -u
-bin=${HYPERSHAPE_BIN:?}
-src=${HYPERSHAPE_SOURCE_DIR:?}
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0 passes=0
-fail() { echo "FAIL: $*"; fails=$((fails+1)); }
-ok() { echo "ok   $*"; passes=$((passes+1)); }
+. "$(dirname "$0")/lib.sh"
 compare() { /usr/bin/python3 "$src/tests/cli/compare_datasets.py" "$@"; }
 
 cat > "$work/tiny.yaml" <<'YAML'
@@ -172,5 +165,4 @@ OUT="$work/a_file" expect output_is_file 's/^seed: 7/seed: 7/'           "not a 
 before=$(find "$work/np1" -type f | sort | xargs md5sum)
 OUT="$work/np1" expect other_dataset 's/seed: 7/seed: 8/'                  "another dataset"
 [ "$before" = "$(find "$work/np1" -type f | sort | xargs md5sum)" ] && ok "the other dataset is untouched" || fail "other dataset modified"
-echo "$passes passed, $fails failed"
-[ "$fails" -eq 0 ]
+finish

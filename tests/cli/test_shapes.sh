@@ -2,12 +2,7 @@
 # `hypershape shapes`: the same shapes on 1 and 3 ranks (bit for bit), and bad dataset configs
 # fail with a message naming the file and the key, a non-zero exit and no output file.
 # Needs HYPERSHAPE_BIN and HYPERSHAPE_SOURCE_DIR (set by CTest).
-set -u
-bin=${HYPERSHAPE_BIN:?}
-src=${HYPERSHAPE_SOURCE_DIR:?}
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0 passes=0
+. "$(dirname "$0")/lib.sh"
 
 # ---- rank independence -------------------------------------------------------------------
 preset="$src/configs/presets/random2d.yaml"
@@ -75,5 +70,4 @@ mkdir -p "$work/broken_dir"
 cp "$src/configs/surfaces/livers/liver_000.stl" "$work/broken_dir/a.stl"
 cp "$work/empty.stl" "$work/broken_dir/b.stl"
 expect broken_in_dir    "s|dim: 2|dim: 3|; s|base: circle|base: directory\n  base_dir: $work/broken_dir|" "shapes.base_dir: $work/broken_dir/b.stl"
-echo "$passes passed, $fails failed"
-[ "$fails" -eq 0 ]
+finish

@@ -5,7 +5,8 @@
 # errors; the error falls as h falls for P1 and for P2; P2 beats P1 at the same h; the
 # reference's Richardson estimate (and its observed order) is reported and finite; the C++
 # metrics agree with scripts/hypershape_data.py's rel_l2 / rel_h1 to round-off on the dumped
-# arrays; the JSON, the markdown table and the Pareto PNG exist.
+# arrays; the JSON, the markdown table and the Pareto PNG exist; an unwritable --out stops it
+# before any work.
 # Needs HYPERSHAPE_BIN (the study binary sits beside it) and HYPERSHAPE_SOURCE_DIR (set by CTest).
 set -u
 bin_dir=$(dirname "${HYPERSHAPE_BIN:?}")
@@ -15,6 +16,11 @@ study="$bin_dir/study_accuracy"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
+
+# An unwritable output stops the study before any work (exit 2, the path and option named).
+msg=$("$study" --tiny --out /proc/no/such/dir/study.json 2>&1 >/dev/null); code=$?
+[ "$code" -eq 2 ] && grep -q -- "--out" <<<"$msg" && ! grep -q "\[study\]" <<<"$msg" ||
+  { echo "FAIL: unwritable --out: exit $code, $msg"; exit 1; }
 
 start=$(date +%s)
 if ! "$study" --tiny --out "$work/study.json" --dump "$work/dump.json" > "$work/table.md" 2> "$work/progress.txt"; then

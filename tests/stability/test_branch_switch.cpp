@@ -27,18 +27,7 @@ namespace {
 int tangent_inertia(const physics::Problem& p, Vec u) {
   core::MatH K = p.create_matrix();
   REQUIRE(p.jacobian(u, K));
-  KSP ksp;
-  PC pc;
-  HS_PETSC(KSPCreate(p.comm(), &ksp));
-  HS_PETSC(KSPSetType(ksp, KSPPREONLY));
-  HS_PETSC(KSPGetPC(ksp, &pc));
-  HS_PETSC(PCSetType(pc, PCCHOLESKY));
-  HS_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
-  HS_PETSC(KSPSetOperators(ksp, K, K));
-  HS_PETSC(KSPSetUp(ksp));
-  const int neg = solver::negative_eigenvalues(ksp);
-  HS_PETSC(KSPDestroy(&ksp));
-  return neg;
+  return hstest::ldlt_negative_eigenvalues(K, MATSOLVERMUMPS);
 }
 
 }  // namespace

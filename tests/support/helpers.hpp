@@ -15,6 +15,7 @@
 #include "hypershape/mesh/gmsh_mesher.hpp"
 #include "hypershape/physics/problem.hpp"
 #include "hypershape/physics/registry.hpp"
+#include "hypershape/solver/nonlinear.hpp"
 
 namespace hstest {
 
@@ -153,6 +154,24 @@ inline hs::mesh::MeshData ball_mesh(double h) {
   hs::mesh::MeshOptions mo;
   mo.h = h;
   return hs::mesh::mesh_ball(mo, hs::mesh::ClampRegion{{1.0, 0.0, 0.0}, 0.5});
+}
+
+/// Negative eigenvalues of the symmetric matrix A by a fresh LDL^T of `package` (MUMPS, PETSc).
+inline int ldlt_negative_eigenvalues(Mat A, const char* package) {
+  KSP ksp;
+  PC pc;
+  MPI_Comm comm;
+  HS_PETSC(PetscObjectGetComm(reinterpret_cast<PetscObject>(A), &comm));
+  HS_PETSC(KSPCreate(comm, &ksp));
+  HS_PETSC(KSPSetType(ksp, KSPPREONLY));
+  HS_PETSC(KSPGetPC(ksp, &pc));
+  HS_PETSC(PCSetType(pc, PCCHOLESKY));
+  HS_PETSC(PCFactorSetMatSolverType(pc, package));
+  HS_PETSC(KSPSetOperators(ksp, A, A));
+  HS_PETSC(KSPSetUp(ksp));
+  const int neg = hs::solver::negative_eigenvalues(ksp);
+  HS_PETSC(KSPDestroy(&ksp));
+  return neg;
 }
 
 inline hs::physics::SpaceOptions degree(int p) {

@@ -30,10 +30,16 @@
 ///   - an increment that fails (max_newton iterations, or no progress after 4) is discarded,
 ///     the state restored and the increment halved; after an easy success (<= 3 iterations) it
 ///     doubles, after a hard one (>= 8) it halves (FEBio-style);
-///   - stability: with MUMPS LDL^T the inertia of every tangent is known (negative pivots =
-///     negative eigenvalues); an equilibrium whose tangent is indefinite ends the path with
-///     "loss of stability" (the body buckles: the states beyond are not the loaded body's);
-///   - a budget of newton_budget iterations per target solve bounds the cost of a failure.
+///   - the first increment from rest is the previous load case's first; max_halvings failures
+///     in a row, or increments below 1e-3 of the way, end the path; limit points of the load
+///     are passed (alpha may fall);
+///   - stability: LDL^T gives the inertia of every tangent (negative pivots = negative
+///     eigenvalues, negative_eigenvalues()); a final state whose tangent is indefinite is an
+///     unstable equilibrium ("loss of stability") and is never returned as converged;
+///   - branch switching (branch_switches times) after a path that ended unstable or stalled:
+///     see switch_branch(); measured on 1000 Random2D load cases: 98.7% -> 99.9% converged;
+///   - a budget of newton_budget iterations per target solve (switches included) bounds the
+///     cost of a failure.
 /// Measured on 2 Random2D shapes x 20 load cases (P1, h 0.04): 18-25 Newton iterations per load
 /// case against 73-103 for the former strategy (control: load: load-controlled solves at
 /// secant-updated alpha), which stays available, as does a load-control fallback after a

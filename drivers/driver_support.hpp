@@ -1,0 +1,67 @@
+#pragma once
+/// What the benchmark and study drivers share: their command line (our options before "--",
+/// PETSc's after) and their JSON output (written under a temporary name, then renamed, so a
+/// killed run never leaves a partial file).
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "hypershape/core/input_error.hpp"
+
+namespace hypershape::drivers {
+
+/// argv split at the first "--": `ours` and `petsc`, each starting with argv[0].
+struct SplitArgs {
+  std::vector<char*> ours, petsc;
+};
+
+inline SplitArgs split_at_dashes(int argc, char** argv) {
+  SplitArgs s{{argv[0]}, {argv[0]}};
+  bool after = false;
+  for (int i = 1; i < argc; ++i) {
+    if (!after && std::string(argv[i]) == "--") {
+      after = true;
+      continue;
+    }
+    (after ? s.petsc : s.ours).push_back(argv[i]);
+  }
+  return s;
+}
+
+/// Checks, before any work, that `path` can be written (creates its directory, opens and
+/// removes `path`.tmp): an unwritable output is reported on stderr as an error naming the
+/// path and `option` and the driver exits (2) instead of losing its results at the end. An
+/// empty path (no output) passes.
+inline bool output_writable(const std::string& path, const std::string& option) {
+  if (path.empty()) return true;
+  const std::filesystem::path p(path);
+  std::error_code ec;
+  if (p.has_parent_path()) std::filesystem::create_directories(p.parent_path(), ec);
+  const std::string tmp = path + ".tmp";
+  if (!std::ofstream(tmp)) {
+    std::cerr << "error: " << path << ": " << option << ": cannot open for writing\n";
+    return false;
+  }
+  std::filesystem::remove(tmp, ec);
+  return true;
+}
+
+/// Writes `j` to `path` (creating its directory) through `path`.tmp and a rename. `option`
+/// names the command-line option the path came from, for the error message.
+inline void write_json_atomic(const std::string& path, const nlohmann::json& j, const std::string& option,
+                              int indent = 2) {
+  const std::filesystem::path p(path);
+  if (p.has_parent_path()) std::filesystem::create_directories(p.parent_path());
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream f(tmp);
+    if (!f) throw core::InputError(path, option, "cannot open for writing");
+    f << j.dump(indent) << "\n";
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+}  // namespace hypershape::drivers
