@@ -380,4 +380,68 @@ double Space::min_det_jacobian() const {
   return m;
 }
 
+const std::vector<PetscInt>& Space::csr_offsets(const PetscInt* ia, const PetscInt* ja, PetscInt n) const {
+  const PetscInt nnz = ia[n];
+  const bool same = csr_ia_.size() == std::size_t(n + 1) && csr_ja_.size() == std::size_t(nnz) &&
+                    std::equal(ia, ia + n + 1, csr_ia_.begin()) && std::equal(ja, ja + nnz, csr_ja_.begin());
+  if (same) return csr_offsets_;
+  csr_ia_.assign(ia, ia + n + 1);
+  csr_ja_.assign(ja, ja + nnz);
+  const int nd = n_cell_dofs();
+  csr_offsets_.assign(std::size_t(c1_ - c0_) * std::size_t(nd * nd), -1);
+  for (PetscInt c = c0_; c < c1_; ++c) {
+    const PetscInt* g = global_dofs(c);
+    PetscInt* off = &csr_offsets_[std::size_t(c - c0_) * std::size_t(nd * nd)];
+    for (int a = 0; a < nd; ++a) {
+      if (g[a] < 0) continue;
+      const PetscInt* row = ja + ia[g[a]];
+      const PetscInt* end = ja + ia[g[a] + 1];
+      for (int b = 0; b < nd; ++b) {
+        if (g[b] < 0) continue;
+        const PetscInt* it = std::lower_bound(row, end, g[b]);
+        if (it == end || *it != g[b]) {  // not in the pattern: the direct path cannot be used
+          csr_ia_.clear();
+          csr_offsets_.clear();
+          return csr_offsets_;
+        }
+        off[a * nd + b] = PetscInt(it - ja);
+      }
+    }
+  }
+  return csr_offsets_;
+}
+
+CellMatrixAdder::CellMatrixAdder(const Space& space, Mat J) : space_(space), J_(J), n_(space.n_cell_dofs()) {
+  PetscBool seqaij = PETSC_FALSE, assembled = PETSC_FALSE;
+  HS_PETSC(PetscObjectTypeCompare((PetscObject)J, MATSEQAIJ, &seqaij));
+  if (seqaij) HS_PETSC(MatAssembled(J, &assembled));
+  if (!seqaij || !assembled) return;  // the first assembly fixes the pattern: MatSetValues
+  PetscInt n;
+  const PetscInt *ia, *ja;
+  PetscBool done;
+  HS_PETSC(MatGetRowIJ(J, 0, PETSC_FALSE, PETSC_FALSE, &n, &ia, &ja, &done));
+  if (!done) return;
+  const auto& off = space.csr_offsets(ia, ja, n);
+  HS_PETSC(MatRestoreRowIJ(J, 0, PETSC_FALSE, PETSC_FALSE, &n, &ia, &ja, &done));
+  if (off.empty() && space.c1_ > space.c0_) return;
+  offsets_ = off.data();
+  HS_PETSC(MatSeqAIJGetArray(J, &values_));
+}
+
+CellMatrixAdder::~CellMatrixAdder() {
+  if (values_) MatSeqAIJRestoreArray(J_, &values_);  // no throw from a destructor
+}
+
+void CellMatrixAdder::add(PetscInt c, const double* Ke) const {
+  if (!values_) {
+    const PetscInt* g = space_.global_dofs(c);
+    HS_PETSC(MatSetValues(J_, n_, g, n_, g, Ke, ADD_VALUES));
+    return;
+  }
+  const std::size_t nn = std::size_t(n_) * std::size_t(n_);
+  const PetscInt* off = offsets_ + std::size_t(c - space_.c0_) * nn;
+  for (std::size_t k = 0; k < nn; ++k)
+    if (off[k] >= 0) values_[off[k]] += Ke[k];
+}
+
 }  // namespace hypershape::physics

@@ -27,6 +27,28 @@ PetscErrorCode guarded(F&& f) {
   }
 }
 
+/// The tangent's linear solver: LDL^T, PETSc's own in 2D on one rank, MUMPS otherwise
+/// (options with the KSP's prefix still apply).
+void configure_direct_solver(KSP ksp, MPI_Comm comm, int dim) {
+  PC pc;
+  HS_PETSC(KSPSetType(ksp, KSPPREONLY));
+  HS_PETSC(KSPGetPC(ksp, &pc));
+  HS_PETSC(PCSetType(pc, PCCHOLESKY));
+  // 2D on one rank: PETSc's own sparse Cholesky (LDL^T without pivoting) in the quotient
+  // minimum degree ordering; measured 1.4x faster per load case than MUMPS on Random2D shapes,
+  // whose per-call overhead dominates at a few thousand unknowns. In 3D its non-supernodal
+  // factorisation is far slower than MUMPS (a Random3D load case took minutes), and a solver
+  // group of several ranks needs a parallel one: MUMPS. Both report the inertia.
+  PetscMPIInt ranks;
+  MPI_Comm_size(comm, &ranks);
+  if (ranks == 1 && dim == 2) {
+    HS_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERPETSC));
+    HS_PETSC(PCFactorSetMatOrderingType(pc, MATORDERINGQMD));
+  } else {
+    HS_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+  }
+}
+
 }  // namespace
 
 void set_default_options(const std::vector<std::pair<std::string, std::string>>& options) {
@@ -64,30 +86,15 @@ NonlinearSolver::NonlinearSolver(const physics::Problem& problem, const SolverOp
   }
   HS_PETSC(SNESSetTolerances(snes_, opt.atol, 1e-50, 0.0, opt.max_newton, -1));
   KSP ksp;
-  PC pc;
   HS_PETSC(SNESGetKSP(snes_, &ksp));
-  HS_PETSC(KSPSetType(ksp, KSPPREONLY));
-  HS_PETSC(KSPGetPC(ksp, &pc));
-  HS_PETSC(PCSetType(pc, PCCHOLESKY));
-  // 2D on one rank: PETSc's own sparse Cholesky (LDL^T without pivoting) in the quotient
-  // minimum degree ordering; measured 1.4x faster per load case than MUMPS on Random2D shapes,
-  // whose per-call overhead dominates at a few thousand unknowns. In 3D its non-supernodal
-  // factorisation is far slower than MUMPS (a Random3D load case took minutes), and a solver
-  // group of several ranks needs a parallel one: MUMPS. Both report the inertia.
-  PetscMPIInt ranks;
-  MPI_Comm_size(comm, &ranks);
-  if (ranks == 1 && problem.space().dim() == 2) {
-    HS_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERPETSC));
-    HS_PETSC(PCFactorSetMatOrderingType(pc, MATORDERINGQMD));
-  } else {
-    HS_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
-  }
+  configure_direct_solver(ksp, problem.comm(), problem.space().dim());
   HS_PETSC(SNESSetFromOptions(snes_));
   PetscBool has_atol = PETSC_FALSE;
   HS_PETSC(PetscOptionsHasName(nullptr, prefix.empty() ? nullptr : prefix.c_str(), "-snes_atol",
                                &has_atol));
   user_atol_ = has_atol;
 }
+
 
 void NonlinearSolver::reset() {
   HS_PETSC(VecZeroEntries(u_));
@@ -306,6 +313,29 @@ int negative_eigenvalues(KSP ksp) {
     HS_PETSC(MatGetInertia(F, &neg, &zero, &pos));
   }
   return int(neg);
+}
+
+bool NonlinearSolver::rest_response() {
+  if (!ksp0_) {
+    // Configured as the SNES's KSP, the same options (prefix) included.
+    KSP ksp;
+    const char* prefix = nullptr;
+    HS_PETSC(SNESGetKSP(snes_, &ksp));
+    HS_PETSC(KSPGetOptionsPrefix(ksp, &prefix));
+    J0_ = problem_.create_matrix();
+    if (!problem_.jacobian(u_, J0_)) return tangent_response();
+    HS_PETSC(KSPCreate(problem_.comm(), ksp0_.out()));
+    HS_PETSC(KSPSetOptionsPrefix(ksp0_, prefix));
+    configure_direct_solver(ksp0_, problem_.comm(), problem_.space().dim());
+    HS_PETSC(KSPSetFromOptions(ksp0_));
+    HS_PETSC(KSPSetOperators(ksp0_, J0_, J0_));
+  }
+  negative_pivots_ = -1;
+  HS_PETSC(KSPSolve(ksp0_, problem_.load(), a_));
+  KSPConvergedReason kr;
+  HS_PETSC(KSPGetConvergedReason(ksp0_, &kr));
+  if (kr > 0) negative_pivots_ = negative_eigenvalues(ksp0_);
+  return kr > 0;
 }
 
 bool NonlinearSolver::tangent_response() {
@@ -591,11 +621,11 @@ TargetResult NonlinearSolver::follow_path(double target, double start, int spent
     t.reason = "target max|u| must be positive";
     return t;
   }
-  if (!tangent_response()) {
+  double d = problem_.max_displacement(u_);
+  if (!(d == 0 ? rest_response() : tangent_response())) {
     t.reason = "tangent factorisation or solve failed at the start";
     return t;
   }
-  double d = problem_.max_displacement(u_);
   double step = target - d;
   // From rest, the first increment is the one the previous load case of this problem took
   // first (its load differs, its difficulty is alike): measured on Random2D draws, this halves

@@ -78,6 +78,17 @@ for h in (0.16, 0.08):
     assert err[(2, h)][0] < err[(1, h)][0], f"P2 is not more accurate than P1 at h {h}: {err}"
 defaults = [r for r in sc["results"] if r["setting"]["is_default"]]
 assert len(defaults) == 1 and defaults[0]["setting"]["name"] == "P1 h0.04", [r["setting"]["name"] for r in defaults]
+# The same-load (training-pair) error: present for every converged load case, and for P1 close
+# to the alpha error (the stiffness the target constraint moves into alpha), well above the
+# same-target error (the study's first finding).
+assert sc["same_load_pass"]["failed"] == 0 and sc["same_load_pass"]["solves"] >= 4, sc["same_load_pass"]
+for r in sc["results"]:
+    for lo in r["loads"]:
+        v = lo.get("same_load_rel_l2")
+        assert v is not None and math.isfinite(v) and v > 0, (r["setting"]["name"], lo.get("same_load_error"))
+dl = defaults[0]["loads"][0]
+assert dl["same_load_rel_l2"] > 2 * dl["rel_l2"], dl
+assert 0.5 < dl["same_load_rel_l2"] / dl["alpha_err"] < 2, dl
 tight = [r for r in sc["results"] if r["setting"]["group"] == "tolerance"][0]
 assert defaults[0]["loads"][0]["solver_l2"] is not None and defaults[0]["loads"][0]["solver_l2"] < 1e-2
 

@@ -53,6 +53,7 @@ using VecH = Handle<Vec, VecDestroy>;
 using MatH = Handle<Mat, MatDestroy>;
 using DMH = Handle<DM, DMDestroy>;
 using SNESH = Handle<SNES, SNESDestroy>;
+using KSPH = Handle<KSP, KSPDestroy>;
 using ISH = Handle<IS, ISDestroy>;
 using SFH = Handle<PetscSF, PetscSFDestroy>;
 using FEH = Handle<PetscFE, PetscFEDestroy>;

@@ -103,6 +103,7 @@ class HyperelasticEffect : public Effect {
       Eigen::Matrix<double, D * D, ND> AG;  // (iJ, b k) = sum_L A(iJ, kL) G(b, L)
       Tensor<D> P;
       Tangent<D> A;
+      const CellMatrixAdder adder(s, J);
       for (PetscInt c = s.cell_begin(); c < s.cell_end(); ++c) {
         detail::gather<D, NB>(s, c, u, ue);
         const double dj = s.det_jacobian(c);
@@ -119,8 +120,7 @@ class HyperelasticEffect : public Effect {
             for (int i = 0; i < D; ++i)
               Ke.row(a * D + i).noalias() += w * (G.row(a) * AG.template middleRows<D>(i * D));
         }
-        const PetscInt* gi = s.global_dofs(c);
-        HS_PETSC(MatSetValues(J, ND, gi, ND, gi, Ke.data(), ADD_VALUES));
+        adder.add(c, Ke.data());
       }
       return true;
     });

@@ -163,6 +163,9 @@ class NonlinearSolver {
   double control_direction(Vec u, Vec fallback, Vec c);
   /// Factorises K(u_) and solves K a_ = f_ext. False if the tangent cannot be formed.
   bool tangent_response();
+  /// tangent_response() at rest (u = 0): K(0) is the same for every load case of the problem
+  /// (dead loads), so it is factorised once, in its own KSP, and kept.
+  bool rest_response();
   /// After a failed path: leaves the state the path ended in (unstable, or where increments
   /// kept failing) along the tangent's softest mode, minimises the energy there at 0.7^attempt
   /// times its load (a stable state on another branch: past a subcritical bifurcation none is
@@ -180,6 +183,8 @@ class NonlinearSolver {
   SolverOptions opt_;
   core::SNESH snes_;
   core::MatH J_;
+  core::KSPH ksp0_;  ///< K(0), factorised once (rest_response)
+  core::MatH J0_;
   core::VecH u_, backup_, r_;
   core::VecH a_, a0_, b_, c_, du_, w_, v_, v0_;  ///< displacement-control work vectors
   double s_ = 0;        ///< load factor of the current state
