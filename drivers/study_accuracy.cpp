@@ -848,7 +848,7 @@ int main(int argc, char** argv) {
   app.add_option("--out", a.out, "JSON results (default results/study_accuracy.json)");
   app.add_option("--dump", a.dump, "also write the arrays of one setting and the reference (JSON) for checks");
   app.add_option("--dims", a.dims, "dimensions to run (full mode)")->check(CLI::IsMember({2, 3}));
-  app.add_option("--scenes", a.scenes, "scene names to run (disk r2d-0 r2d-1 ood-0 ball r3d-0)");
+  app.add_option("--scenes", a.scenes, "scene names to run (disk r2d-0 r2d-1 ood-0 easy-0 ball r3d-0)");
   app.add_option("--repeats", a.repeats, "repeats per load case (default 3; tiny 1)")->check(CLI::Range(1, 50));
   app.add_option("--repeat-above", a.repeat_above, "a load case whose first run takes longer (s) is not repeated")
       ->check(CLI::PositiveNumber);
@@ -893,6 +893,7 @@ int main(int argc, char** argv) {
                                        {"r2d-0", "random2d", SceneKind::random2d, 0},
                                        {"r2d-1", "random2d", SceneKind::random2d, 1},
                                        {"ood-0", "ood_random2d", SceneKind::random2d, 0},
+                                       {"easy-0", "easy_random2d", SceneKind::random2d, 0},
                                        {"ball", "random3d", SceneKind::ball, 0},
                                        {"r3d-0", "random3d", SceneKind::random3d, 0}};
       for (const auto& s : all) {
