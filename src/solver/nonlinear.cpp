@@ -622,7 +622,11 @@ TargetResult NonlinearSolver::follow_path(double target, double start, int spent
     return t;
   }
   double d = problem_.max_displacement(u_);
-  if (!(d == 0 ? rest_response() : tangent_response())) {
+  // From rest in 2D, K(0) is factorised once per problem. Not in 3D: a second MUMPS factor
+  // there doubles the factor memory (hundreds of MiB per rank at the 3D presets' sizes) for
+  // one factorisation in about ten per load case.
+  const bool cached_rest = d == 0 && problem_.space().dim() == 2;
+  if (!(cached_rest ? rest_response() : tangent_response())) {
     t.reason = "tangent factorisation or solve failed at the start";
     return t;
   }

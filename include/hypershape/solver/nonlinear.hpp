@@ -164,7 +164,7 @@ class NonlinearSolver {
   /// Factorises K(u_) and solves K a_ = f_ext. False if the tangent cannot be formed.
   bool tangent_response();
   /// tangent_response() at rest (u = 0): K(0) is the same for every load case of the problem
-  /// (dead loads), so it is factorised once, in its own KSP, and kept.
+  /// (dead loads), so it is factorised once, in its own KSP, and kept (2D problems only).
   bool rest_response();
   /// After a failed path: leaves the state the path ended in (unstable, or where increments
   /// kept failing) along the tangent's softest mode, minimises the energy there at 0.7^attempt
