@@ -37,6 +37,14 @@ out = {"slice": {"shapes": shapes, "load_cases_per_shape": loads}, "repeats": re
 out["efficiency_2_ranks"] = rate[2] / (2 * rate[1])
 out["projected_hours_random2d_1000x50"] = {n: 50000 / rate[n] / 3600 for n in (1, 2)}
 out["projected_hours_2_ranks_range"] = [50000 / max(rates[2]) / 3600, 50000 / min(rates[2]) / 3600]
+# Where the 2-rank run loses against twice the 1-rank rate, from the median runs: the work done
+# per load case (phase seconds summed over ranks; > 1: the ranks slow each other down, sharing
+# the machine), and the time ranks sit idle at the end of the slice (shards are handed out one at
+# a time: with 20 shapes in shards of 2, the last shard runs alone). The full Random2D has 125
+# shards of the default 8 shapes, so its tail is a shard or less of an hour (under 1%).
+busy = {n: sum(r[n]["seconds"]["phases_summed_over_groups"].values()) for n in (1, 2)}
+out["work_per_load_case_2_vs_1"] = busy[2] / busy[1]
+out["idle_share_2_ranks"] = 1 - busy[2] / (2 * r[2]["seconds"]["wall"])
 json.dump(out, open("results/bench_generate.json", "w"), indent=1)
 print(f"Random2D slice: {shapes} shapes x {loads} load cases, {repeats} runs per rank count (alternated)")
 for n in (1, 2):
@@ -53,6 +61,9 @@ for n in (1, 2):
 print(f"2 ranks: {100 * out['efficiency_2_ranks']:.0f}% of twice the 1-rank rate (medians); full Random2D on 2 ranks: "
       f"{out['projected_hours_random2d_1000x50'][2]:.2f} h (runs: {out['projected_hours_2_ranks_range'][0]:.2f}-"
       f"{out['projected_hours_2_ranks_range'][1]:.2f} h)")
+print(f"2 ranks lose {100 * (out['work_per_load_case_2_vs_1'] - 1):.1f}% to more work per load case (the ranks share "
+      f"the machine) and {100 * out['idle_share_2_ranks']:.1f}% to time outside the phases (start-up, and the end of the slice: shards handed "
+      f"out one at a time); without that tail: {100 / out['work_per_load_case_2_vs_1']:.0f}% of twice the 1-rank rate")
 print("\nPhase split (seconds summed over ranks):")
 print("| phase | 1 rank | share | 2 ranks | share |")
 print("|---|---|---|---|---|")
