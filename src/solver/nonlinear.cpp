@@ -95,7 +95,6 @@ NonlinearSolver::NonlinearSolver(const physics::Problem& problem, const SolverOp
   user_atol_ = has_atol;
 }
 
-
 void NonlinearSolver::reset() {
   HS_PETSC(VecZeroEntries(u_));
   s_ = 0;
