@@ -257,16 +257,8 @@ json to_json(const PresetRecord& r) {
 }
 
 json machine_note() {
-  json m;
-  char host[256] = {0};
-  gethostname(host, sizeof(host) - 1);
-  m["hostname"] = host;
-  m["nproc"] = long(sysconf(_SC_NPROCESSORS_ONLN));
+  json m = hs::drivers::machine_note();
   m["load_average_start"] = load_average();
-  std::time_t now = std::time(nullptr);
-  char buf[64];
-  std::strftime(buf, sizeof(buf), "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
-  m["date_utc"] = buf;
   return m;
 }
 

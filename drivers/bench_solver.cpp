@@ -409,24 +409,8 @@ json to_json(const CaseRecord& c) {
 }
 
 json machine_note(MPI_Comm comm) {
-  json m;
-  char host[256] = {0};
-  gethostname(host, sizeof(host) - 1);
-  m["hostname"] = host;
-  m["nproc"] = long(sysconf(_SC_NPROCESSORS_ONLN));
+  json m = hs::drivers::machine_note();
   m["mpi_ranks"] = hs::core::size(comm);
-  char version[256];
-  HS_PETSC(PetscGetVersion(version, sizeof(version)));
-  m["petsc_version"] = version;
-  std::error_code ec;
-  auto blas = std::filesystem::canonical("/etc/alternatives/libblas.so.3-x86_64-linux-gnu", ec);
-  m["libblas_so_3"] = ec ? json(nullptr) : json(blas.string());
-  const char* obt = std::getenv("OPENBLAS_NUM_THREADS");
-  m["OPENBLAS_NUM_THREADS"] = obt ? json(obt) : json(nullptr);
-  std::time_t now = std::time(nullptr);
-  char buf[64];
-  std::strftime(buf, sizeof(buf), "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
-  m["date_utc"] = buf;
   return m;
 }
 

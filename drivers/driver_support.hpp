@@ -1,7 +1,12 @@
 #pragma once
 /// What the benchmark and study drivers share: their command line (our options before "--",
 /// PETSc's after) and their JSON output (written under a temporary name, then renamed, so a
-/// killed run never leaves a partial file).
+/// killed run never leaves a partial file), and the note on the machine they ran on.
+#include <petscsys.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -9,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "hypershape/core/error.hpp"
 #include "hypershape/core/input_error.hpp"
 
 namespace hypershape::drivers {
@@ -62,6 +68,37 @@ inline void write_json_atomic(const std::string& path, const nlohmann::json& j, 
     f << j.dump(indent) << "\n";
   }
   std::filesystem::rename(tmp, path);
+}
+
+/// The machine a figure was measured on: host, cores, CPU model, PETSc version, the BLAS behind
+/// libblas.so.3 and OPENBLAS_NUM_THREADS, and the date (UTC).
+inline nlohmann::json machine_note() {
+  using nlohmann::json;
+  json m;
+  char host[256] = {0};
+  gethostname(host, sizeof(host) - 1);
+  m["hostname"] = host;
+  m["nproc"] = long(sysconf(_SC_NPROCESSORS_ONLN));
+  std::ifstream cpu("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(cpu, line))
+    if (line.rfind("model name", 0) == 0) {
+      m["cpu_model"] = line.substr(line.find(':') + 2);
+      break;
+    }
+  char version[256];
+  HS_PETSC(PetscGetVersion(version, sizeof(version)));
+  m["petsc_version"] = version;
+  std::error_code ec;
+  auto blas = std::filesystem::canonical("/etc/alternatives/libblas.so.3-x86_64-linux-gnu", ec);
+  m["libblas_so_3"] = ec ? json(nullptr) : json(blas.string());
+  const char* obt = std::getenv("OPENBLAS_NUM_THREADS");
+  m["OPENBLAS_NUM_THREADS"] = obt ? json(obt) : json(nullptr);
+  std::time_t now = std::time(nullptr);
+  char buf[64];
+  std::strftime(buf, sizeof(buf), "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+  m["date_utc"] = buf;
+  return m;
 }
 
 }  // namespace hypershape::drivers

@@ -193,34 +193,6 @@ double cpu_now() {
 
 // ---- machine --------------------------------------------------------------------------------
 
-json machine_note() {
-  json m;
-  char host[256] = {0};
-  gethostname(host, sizeof(host) - 1);
-  m["hostname"] = host;
-  m["nproc"] = long(sysconf(_SC_NPROCESSORS_ONLN));
-  std::ifstream cpu("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(cpu, line))
-    if (line.rfind("model name", 0) == 0) {
-      m["cpu_model"] = line.substr(line.find(':') + 2);
-      break;
-    }
-  char version[256];
-  HS_PETSC(PetscGetVersion(version, sizeof(version)));
-  m["petsc_version"] = version;
-  std::error_code ec;
-  auto blas = std::filesystem::canonical("/etc/alternatives/libblas.so.3-x86_64-linux-gnu", ec);
-  m["libblas_so_3"] = ec ? json(nullptr) : json(blas.string());
-  const char* obt = std::getenv("OPENBLAS_NUM_THREADS");
-  m["OPENBLAS_NUM_THREADS"] = obt ? json(obt) : json(nullptr);
-  std::time_t now = std::time(nullptr);
-  char buf[64];
-  std::strftime(buf, sizeof(buf), "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
-  m["date_utc"] = buf;
-  return m;
-}
-
 json load_average() {
   std::ifstream f("/proc/loadavg");
   double a = NAN, b = NAN, c = NAN;
@@ -907,7 +879,7 @@ int main(int argc, char** argv) {
     json out;
     out["study"] = "study_accuracy";
     out["mode"] = a.tiny ? "tiny" : "full";
-    out["machine"] = machine_note();
+    out["machine"] = hs::drivers::machine_note();
     out["load_average_start"] = load_average();
     out["parameters"] = {{"repeats", a.repeats},
                          {"repeat_above_seconds", a.repeat_above},

@@ -181,7 +181,7 @@ def fmt_t(v):
     return f"{v * 1e3:.0f} ms" if v < 1 else f"{v:.2f} s"
 
 
-def panel(ax, rows, refs, front, key_e, point_index, budgets):
+def panel(ax, rows, refs, front, key_e, point_index):
     """One error-vs-time panel: every setting (per-scene points faint), the front, the default."""
     for r in rows:
         if not r["ok"]:
@@ -221,10 +221,6 @@ def panel(ax, rows, refs, front, key_e, point_index, budgets):
     if est_a and key_e == "same":
         ax.axhline(float(np.mean(est_a)), color="gray", ls="--", lw=1,
                    label="reference's own alpha error (Richardson)")
-    for name, value in budgets:
-        ax.axhline(value, color="tab:red", ls=":", lw=0.9)
-        ax.annotate(f"{name} best model", (ax.get_xlim()[0], value), textcoords="offset points", xytext=(3, 2),
-                    fontsize=6.5, color="tab:red")
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel(f"{'CPU' if TIME_KEY == 'cpu_seconds' else 'wall'} time per load case [s] "
@@ -237,18 +233,21 @@ def plot(rows, refs, front, front_same, dim, path, machine):
     has_same = any(math.isfinite(r["same"]) for r in rows)
     fig, axes = plt.subplots(1, 2 if has_same else 1, figsize=(15.0 if has_same else 8.5, 6.0), squeeze=False)
     ax = axes[0][0]
-    panel(ax, rows, refs, front, "l2", 1, [])
+    panel(ax, rows, refs, front, "l2", 1)
     ax.set_ylabel("relative L2 error of u vs the reference, at the same target max|u|")
     ax.set_title(f"{dim}D, at the same target ({', '.join(x['scene'] for x in refs)}); "
                  f"{machine.get('nproc', '?')} cores, {machine.get('cpu_model', '?')[:40]}", fontsize=9)
     ax.legend(fontsize=7, loc="best")
     if has_same:
         ax = axes[0][1]
-        budgets = [(ds, best) for ds, (best, _) in TABLE2.get(dim, {}).items()]
-        panel(ax, rows, refs, front_same, "same", 2, [])
-        ax.autoscale()
+        panel(ax, rows, refs, front_same, "same", 2)
         lo, hi = ax.get_ylim()
-        panel(ax, [], refs, [], "same", 2, [(n, v) for n, v in budgets if lo <= v <= hi * 3])
+        x0 = ax.get_xlim()[0]
+        for name, (best, _) in TABLE2.get(dim, {}).items():  # the budgets within the plotted range
+            if lo <= best <= hi * 3:
+                ax.axhline(best, color="tab:red", ls=":", lw=0.9)
+                ax.annotate(f"{name} best model", (x0, best), textcoords="offset points", xytext=(3, 2),
+                            fontsize=6.5, color="tab:red")
         ax.set_ylabel("relative L2 error of u vs the reference at the same load (the training pair)")
         ax.set_title(f"{dim}D, as a training pair: the same traction alpha g phi; dotted: Table 2's best models",
                      fontsize=9)

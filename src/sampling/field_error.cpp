@@ -145,20 +145,21 @@ double NodalNorms::h1_norm(std::span<const double> field, int n_comp) const {
   return std::sqrt(s / double(n_nodes_));
 }
 
-double NodalNorms::rel_l2(std::span<const double> u, std::span<const double> u_hat, int n_comp) const {
+std::vector<double> NodalNorms::difference(std::span<const double> u, std::span<const double> u_hat,
+                                           int n_comp) const {
   check(u, n_comp);
   check(u_hat, n_comp);
   std::vector<double> diff(u.size());
   for (std::size_t i = 0; i < u.size(); ++i) diff[i] = u[i] - u_hat[i];
-  return discrete_l2_norm(diff, n_comp) / discrete_l2_norm(u, n_comp);
+  return diff;
+}
+
+double NodalNorms::rel_l2(std::span<const double> u, std::span<const double> u_hat, int n_comp) const {
+  return discrete_l2_norm(difference(u, u_hat, n_comp), n_comp) / discrete_l2_norm(u, n_comp);
 }
 
 double NodalNorms::rel_h1(std::span<const double> u, std::span<const double> u_hat, int n_comp) const {
-  check(u, n_comp);
-  check(u_hat, n_comp);
-  std::vector<double> diff(u.size());
-  for (std::size_t i = 0; i < u.size(); ++i) diff[i] = u[i] - u_hat[i];
-  return h1_norm(diff, n_comp) / h1_norm(u, n_comp);
+  return h1_norm(difference(u, u_hat, n_comp), n_comp) / h1_norm(u, n_comp);
 }
 
 }  // namespace hypershape::sampling

@@ -53,6 +53,8 @@ class NodalNorms {
 
  private:
   void check(std::span<const double> field, int n_comp) const;
+  /// u - u_hat, after checking both sizes.
+  std::vector<double> difference(std::span<const double> u, std::span<const double> u_hat, int n_comp) const;
   int dim_ = 0, width_ = 0;
   std::size_t n_nodes_ = 0, n_cells_ = 0;
   std::vector<std::int64_t> cells_;
