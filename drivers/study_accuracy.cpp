@@ -208,6 +208,9 @@ hs::config::DatasetConfig scene_config(const SceneSpec& s, const std::string& ov
                                         "<study_accuracy --override>");
 }
 
+/// The preset's element size: shapes.h, or the coarser mesh.h of the 3D presets.
+double preset_mesh_h(const hs::config::DatasetConfig& cfg) { return std::max(cfg.shapes.h, cfg.shapes.mesh_h); }
+
 /// The shapes of one scene, one per h, all with the same Dirichlet centre p_D (so that every h
 /// discretises the same boundary-value problem):
 ///  - disk / ball: the unit circle / sphere with p_D = (1, 0[, 0]) (the seed paper's scene),
@@ -217,8 +220,8 @@ hs::config::DatasetConfig scene_config(const SceneSpec& s, const std::string& ov
 ///  - random2d: factory::make_shape at every h, with the preset's neck threshold (the factory's
 ///    own samples at the preset's h; p_D moves with h by
 ///    up to a quarter of h, see dirichlet_center_offset in the results and docs/ACCURACY.md);
-///  - random3d: factory::make_shape once at the finest h, then its surface remeshed at every
-///    coarser h with the same clamp sphere (geometry::remesh_surface, the factory's 3D step).
+///  - random3d: factory::make_shape drawn at the finest h and meshed at h (mesh_h: its surface
+///    remeshed with the same clamp sphere, as the factory's coarse 3D meshes are).
 class ShapeCache {
  public:
   ShapeCache(SceneKind kind, hs::factory::ShapeConfig c, std::uint64_t seed, std::int64_t id, double finest_h)
@@ -318,18 +321,19 @@ class ShapeCache {
         return hs::factory::make_shape(c, std::nullopt, seed_, id_);
       }
       case SceneKind::random3d: {
-        if (!source_) {
-          auto c = config_;
-          c.h = finest_h_;
-          source_ = std::make_unique<hs::factory::ShapeSample>(hs::factory::make_shape(c, std::nullopt, seed_, id_));
-        }
-        if (std::abs(h - finest_h_) < 1e-12) return *source_;
-        hs::geometry::RemeshOptions ro;
-        ro.target_edge = h;
-        ro.clamp_center = source_->dirichlet_center;
-        ro.clamp_radius = r;
-        auto out = finish(hs::geometry::remesh_surface(source_->boundary, ro), source_->dirichlet_center, h);
-        out.attempt = source_->attempt;
+        // The factory's own coarse mesh (ShapeConfig::mesh_h): the shape drawn at the finest
+        // h, its surface remeshed at h with the same clamp sphere. The draw must not change
+        // with h (a coarse surface failing its checks would make the factory redraw).
+        auto c = config_;
+        c.h = finest_h_;
+        c.mesh_h = h;
+        auto out = hs::factory::make_shape(c, std::nullopt, seed_, id_);
+        if (!attempt_) attempt_ = out.attempt;
+        if (out.attempt != *attempt_)
+          throw std::runtime_error("random3d shape " + std::to_string(id_) + " at h " + fmt_g(h) +
+                                   ": the coarse surface fails the factory's checks (draw " +
+                                   std::to_string(out.attempt) + " instead of " +
+                                   std::to_string(*attempt_) + ")");
         return out;
       }
     }
@@ -342,7 +346,7 @@ class ShapeCache {
   std::int64_t id_;
   double finest_h_;
   std::optional<hs::geometry::Boundary> sphere_;
-  std::unique_ptr<hs::factory::ShapeSample> source_;
+  std::optional<int> attempt_;  ///< random3d: the draw accepted at the first h built
   double grade_end_ = 1.0;
   std::vector<std::pair<std::pair<double, bool>, std::unique_ptr<hs::factory::ShapeSample>>> shapes_;
   std::vector<std::pair<std::pair<double, bool>, double>> seconds_;
@@ -648,7 +652,7 @@ void same_load_pass(json& sc, const hs::factory::ShapeSample& ref_shape, const h
 std::vector<Setting> make_settings(int dim, const Args& a, const hs::config::DatasetConfig& cfg, double ref_h,
                                    SceneKind scene_kind) {
   std::vector<Setting> out;
-  const double h0 = cfg.shapes.h;
+  const double h0 = preset_mesh_h(cfg);
   const int p0 = cfg.degree;
   const bool tiny = a.tiny;
   Setting base;
@@ -925,7 +929,7 @@ int main(int argc, char** argv) {
         // attempt (sub-seed) at every h of the study, so that every h meshes the same random
         // shape (the mesh quality gate or the thinnest-feature test, both h-dependent, may
         // accept another attempt at another h).
-        std::vector<double> all_h{cfg.shapes.h};
+        std::vector<double> all_h{cfg.shapes.h, preset_mesh_h(cfg)};
         const int n_levels = d == 2 ? a.ladder : a.ladder3d;
         for (int level = 0; level < n_levels; ++level) all_h.push_back(ref_h * std::pow(2.0, level));
         for (const auto& s : settings) all_h.push_back(s.h);
@@ -936,7 +940,7 @@ int main(int argc, char** argv) {
           auto c = std::make_unique<ShapeCache>(spec.kind, cfg.shapes, cfg.seed, id, finest_h);
           c->set_grading(a.ref_grading);
           try {
-            const auto& b = c->at(cfg.shapes.h);
+            const auto& b = c->at(preset_mesh_h(cfg));
             if (spec.kind == SceneKind::random2d)
               for (double h : all_h) check_same_draw(c->at(h), b, h);
             cache = std::move(c);
@@ -947,6 +951,10 @@ int main(int argc, char** argv) {
         }
         if (!cache) throw std::runtime_error("no shape id with the same draw at every h in 20 tries");
         ShapeCache& shapes = *cache;
+        // The load cases are drawn on the shape at the resolution it is drawn at (shapes.h):
+        // p_N is a uniform boundary point and so moves with the facets (see "p_D moves with h"
+        // in docs/ACCURACY.md); drawn on the preset's coarser 3D mesh they would be other load
+        // cases, and the study would not compare with its earlier runs.
         const auto& base_shape = shapes.at(cfg.shapes.h);
         sc["shape_id"] = base_shape.shape_id;
         sc["shape_ids_skipped"] = skipped;

@@ -5,6 +5,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <fmt/format.h>
+
 #include "hypershape/mesh/surface_file.hpp"
 #include "solver_block.hpp"
 #include "yaml_block.hpp"
@@ -236,7 +238,18 @@ DatasetConfig parse_dataset_text(const std::string& text, const std::string& sou
       if (d != 1 && d != 2) m.fail("degree", "must be 1 or 2");
       c.degree = int(d);
     }
-    m.allowed("degree (the element size is shapes.h)");
+    if (m.has("h")) {
+      const double mh = m.number("h");
+      if (c.shapes.dim != 3)
+        m.fail("h", "only for 3D shapes (a 2D boundary is resolved by curvature and shapes.h; "
+                    "set shapes.h)");
+      if (!(mh >= c.shapes.h && mh <= 0.5))
+        m.fail("h", fmt::format("must be in [shapes.h = {:g}, 0.5] (the mesh is never finer than "
+                                "the surface the shape is drawn at; the 3D presets set mesh.h "
+                                "0.3: with a coarser shapes.h set mesh.h too)", c.shapes.h));
+      c.shapes.mesh_h = mh;
+    }
+    m.allowed("degree, h (3D: mesh edge length when coarser than shapes.h)");
     m.check_all_used();
   }
   {

@@ -110,7 +110,7 @@ geometry::Boundary draw_boundary(const ShapeConfig& c, const std::optional<geome
     return b;
   }
   // 3D: resolve the surface at h in the pre-image, then remesh it to h (conforming to the
-  // patch curve).
+  // patch curve), and to mesh_h where the mesh is coarser.
   const geometry::BaseKind kind = base ? geometry::BaseKind::triangulated : geometry::BaseKind::sphere;
   const geometry::Boundary base_surface = base ? *base : geometry::icosphere(3);
   geometry::SurfaceSamples dense;
@@ -144,10 +144,27 @@ geometry::Boundary draw_boundary(const ShapeConfig& c, const std::optional<geome
   const double thinnest = *std::min_element(radius_in.begin(), radius_in.end());
   // Surfaces are remeshed uniformly at h (CGAL 5.5 has no adaptive sizing), so a neck must
   // hold at least two boundary edges across.
-  if (thinnest < std::max(min_feature, 0.25 * h))
+  const double neck = std::max(min_feature, 0.25 * h);
+  if (thinnest < neck)
     throw Rejection{"feature", fmt::format("a neck of half-width {:.3g} is thinner than {:.3g} "
                                            "(h / 4: surfaces are resolved uniformly at h)",
-                                           thinnest, std::max(min_feature, 0.25 * h))};
+                                           thinnest, neck)};
+  if (c.mesh_h <= h) return b;
+  // A simulation mesh coarser than the shape: the accepted surface remeshed at mesh_h (same
+  // clamp sphere), which must pass the same checks; its necks are held to the h-level
+  // threshold, so a neck the coarse surface pinches is redrawn rather than solved on.
+  remesh.target_edge = c.mesh_h;
+  try {
+    b = geometry::remesh_surface(b, remesh);
+  } catch (const std::exception& e) {
+    throw Rejection{"boundary", fmt::format("remeshed at mesh.h {:g}: {}", c.mesh_h, e.what())};
+  }
+  if (const auto check = geometry::check_boundary(b); !check.ok)
+    throw Rejection{"boundary", fmt::format("remeshed at mesh.h {:g}: {}", c.mesh_h, check.reason)};
+  const std::vector<double> coarse_in = geometry::inscribed_radii(b);
+  if (const double t = *std::min_element(coarse_in.begin(), coarse_in.end()); t < neck)
+    throw Rejection{"feature", fmt::format("remeshed at mesh.h {:g}, a neck of half-width {:.3g} "
+                                           "is thinner than {:.3g}", c.mesh_h, t, neck)};
   return b;
 }
 
@@ -203,7 +220,7 @@ ShapeSample make_shape(const ShapeConfig& config, const std::optional<geometry::
       out.boundary = draw_boundary(config, surface, seed, shape_id, attempt, out);
       const double t1 = core::now_seconds();
       mesh::BoundaryMeshOptions mopt;
-      mopt.h = config.h;
+      mopt.h = std::max(config.h, config.mesh_h);
       mopt.point_sizes = boundary_spacing(out.boundary);
       try {
         out.mesh = mesh::mesh_boundary(out.boundary, mopt);

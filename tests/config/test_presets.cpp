@@ -20,6 +20,16 @@ config::DatasetConfig by_name(const std::string& text) {
   return config::parse_dataset_text(text, "<test>");
 }
 
+/// "key | message" of the InputError the config text raises, or "no error".
+std::string error_of(const std::string& text) {
+  try {
+    (void)by_name(text);
+  } catch (const core::InputError& e) {
+    return e.key() + " | " + e.what();
+  }
+  return "no error";
+}
+
 std::string shipped_livers() { return std::string(HS_SOURCE_DIR) + "/configs/surfaces/livers"; }
 
 }  // namespace
@@ -78,14 +88,6 @@ TEST_CASE("liver and one_liver: one shape per shipped surface file, no deformati
 }
 
 TEST_CASE("a directory family's keys are checked", "[config][presets]") {
-  auto error_of = [](const std::string& text) {
-    try {
-      (void)by_name(text);
-    } catch (const core::InputError& e) {
-      return e.key() + " | " + e.what();
-    }
-    return std::string("no error");
-  };
   CHECK_THAT(error_of("preset: liver\nshapes: {count: 1000}\n"), Catch::StartsWith("shapes.count"));
   CHECK_THAT(error_of("preset: liver\nshapes: {base_dir: /nonexistent/livers}\n"),
              Catch::StartsWith("shapes.base_dir") && Catch::Contains("no such directory"));
@@ -95,4 +97,20 @@ TEST_CASE("a directory family's keys are checked", "[config][presets]") {
              Catch::StartsWith("shapes.base"));
   CHECK_THAT(error_of("preset: liver\nshapes: {base_file: x.stl}\n"), Catch::StartsWith("shapes.base_file"));
   CHECK_THAT(error_of("preset: random3d\nshapes: {count: null}\n"), Catch::StartsWith("shapes.count"));
+}
+
+TEST_CASE("mesh.h: a 3D mesh coarser than its shape, checked", "[config][presets]") {
+  const auto c = by_name("preset: random3d\nshapes: {h: 0.1}\nmesh: {degree: 2, h: 0.3}\n");
+  CHECK(c.shapes.h == 0.1);
+  CHECK(c.shapes.mesh_h == 0.3);
+  CHECK(c.degree == 2);
+  // The 3D presets set it (merged under an override of the degree alone); 2D ones do not.
+  CHECK(by_name("preset: random3d\nmesh: {degree: 1}\n").shapes.mesh_h == 0.3);
+  CHECK(by_name("preset: liver\n").shapes.mesh_h == 0.2);
+  CHECK(by_name("preset: random2d\n").shapes.mesh_h == 0.0);
+  CHECK_THAT(error_of("preset: random2d\nmesh: {h: 0.1}\n"),
+             Catch::StartsWith("mesh.h") && Catch::Contains("only for 3D"));
+  CHECK_THAT(error_of("preset: random3d\nshapes: {h: 0.1}\nmesh: {h: 0.05}\n"),
+             Catch::StartsWith("mesh.h") && Catch::Contains("[shapes.h = 0.1, 0.5]"));
+  CHECK_THAT(error_of("preset: random3d\nmesh: {h: big}\n"), Catch::StartsWith("mesh.h"));
 }

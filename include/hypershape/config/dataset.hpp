@@ -28,7 +28,9 @@
 ///   gamma: 0.2                    # traction width (paper: 0.2 in 2D, 0.1 in 3D)
 ///   target: [0.1, 0.5]            # max|u| range, covered by stratified sampling
 /// material: {E: 500, nu: 0.49}    # compressible Neo-Hookean (appendix A)
-/// mesh: {degree: 1}               # P1 | P2
+/// mesh: {degree: 1}               # P1 | P2; h: 3D only, optional: the mesh's edge length when
+///                                 # coarser than shapes.h (the shape is drawn at shapes.h, its
+///                                 # surface remeshed at h; see factory::ShapeConfig::mesh_h)
 /// representations:
 ///   point_cloud: true             # SDF, Dirichlet distance and traction at the mesh nodes
 ///   grid: true                    # SDF, Dirichlet distance, traction, displacement on a grid

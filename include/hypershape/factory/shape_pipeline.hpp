@@ -30,7 +30,14 @@ struct ShapeConfig {
   std::string base_dir;
   std::vector<std::string> base_files;
   geometry::DeformationSpec deformation;  ///< steps, velocity unit, grid resolution
-  double h = 0.05;                       ///< target element size (normalised units)
+  double h = 0.05;                       ///< target element size (normalised units): the
+                                         ///< resolution the shape is drawn and checked at
+  /// 3D: edge length of the simulation mesh when coarser than h (0: h). The accepted surface
+  /// (resolved at h, necks checked at h / 4) is remeshed at mesh_h with the same clamp sphere,
+  /// checked again (closed, no self-intersection, no neck thinner than the h-level threshold)
+  /// and filled at mesh_h; the stored boundary is that coarser surface, the domain solved on.
+  /// Lets P2 run on a coarse mesh without coarsening the family of shapes it is drawn from.
+  double mesh_h = 0.0;
   double dirichlet_radius = 0.5;         ///< r of the Dirichlet patch; 0: no patch
   double max_turn_deg = 15.0;            ///< 2D: largest turning angle per boundary edge
   double min_feature_fraction = 0.1;     ///< redraw if a feature is thinner than this * h
