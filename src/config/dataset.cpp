@@ -246,7 +246,7 @@ DatasetConfig parse_dataset_text(const std::string& text, const std::string& sou
       if (!(mh >= c.shapes.h && mh <= 0.5))
         m.fail("h", fmt::format("must be in [shapes.h = {:g}, 0.5] (the mesh is never finer than "
                                 "the surface the shape is drawn at; the 3D presets set mesh.h "
-                                "0.3: with a coarser shapes.h set mesh.h too)", c.shapes.h));
+                                "(0.2 or 0.3): with a coarser shapes.h set mesh.h too)", c.shapes.h));
       c.shapes.mesh_h = mh;
     }
     m.allowed("degree, h (3D: mesh edge length when coarser than shapes.h)");

@@ -2,7 +2,7 @@
 # `hypershape generate`:
 #  - the same dataset on 1, 2 and 3 ranks and as a 3-task array merged by `hypershape index`,
 #    bit for bit, and with a solver group of 2 ranks to round-off (every array compared,
-#    tests/cli/compare_datasets.py);
+#    tests/cli/compare_datasets.py), in 2D and for one 3D shape as the 3D presets solve it;
 #  - kill -9 mid-run, then the same command: equal to the uninterrupted run, no temporary file;
 #  - a load case forced to fail is recorded (status 0, reason) and nothing stored is NaN;
 #  - bad configs and options stop before any work: message naming the key, non-zero exit,
@@ -38,6 +38,19 @@ done
 # A group of 2 ranks solves each shape on a METIS partition: sums run in another order, so the
 # values agree to round-off (measured: 5e-16 in u, 1e-13 in alpha), not bit for bit.
 if compare "$work/np1" "$work/g2" --rtol 1e-9; then ok "1 rank == groups of 2 ranks, to 1e-9"; else fail "1 rank != g2"; fi
+# 3D as the presets solve it: P2 on the surface remeshed at mesh.h 0.3 (one shape, 2 load cases;
+# about 15 s), 1 rank against a solver group of 2 (measured: identical to 1e-12).
+printf 'preset: random3d\nname: tiny3d\nseed: 7\nshapes: {count: 1}\nloads: {count: 2}\nrepresentations: {grid_size: 8}\n' > "$work/tiny3d.yaml"
+"$bin" -q generate "$work/tiny3d.yaml" --progress 0 -o "$work/np1_3d" || fail "3D, 1 rank"
+mpiexec -n 2 "$bin" -q generate "$work/tiny3d.yaml" --progress 0 --group-size 2 -o "$work/g2_3d" || fail "3D, group of 2"
+if compare "$work/np1_3d" "$work/g2_3d" --rtol 1e-9; then ok "3D P2 on mesh.h 0.3: 1 rank == a group of 2, to 1e-9"; else fail "3D: 1 rank != g2"; fi
+/usr/bin/python3 - "$work/np1_3d" <<'PY' && ok "3D: P2 cells on the coarse surface, both load cases converged" || fail "3D dataset"
+import h5py, sys
+g = h5py.File(f"{sys.argv[1]}/shards/shard-000000.h5")["shapes/000000"]
+assert g["cells"].shape[1] == 10, g["cells"].shape             # P2 tetrahedra
+assert g["boundary/facets"].shape[0] < 1000, g["boundary/facets"].shape  # ~300 at 0.3, ~3000 at 0.1
+assert g["loads/status"][:].tolist() == [1, 1], g["loads/reason"][:]
+PY
 /usr/bin/python3 - "$work/np1" <<'PY' && ok "manifest, splits, stats, xdmf present" || fail "dataset files"
 import json, os, sys
 d = sys.argv[1]
@@ -121,6 +134,8 @@ expect gamma_range     's/loads: {count: 3}/loads: {gamma: -1}/'           "load
 expect nu_range        's/^seed: 7/seed: 7\nmaterial: {nu: 0.5}/'          "material.nu"
 expect E_type          's/^seed: 7/seed: 7\nmaterial: {E: soft}/'          "material.E"
 expect degree          's/^seed: 7/seed: 7\nmesh: {degree: 3}/'            "mesh.degree"
+expect mesh_h_2d       's/^seed: 7/seed: 7\nmesh: {h: 0.2}/'               "mesh.h: only for 3D shapes"
+expect mesh_h_fine     's/preset: random2d/preset: random3d/; s/^seed: 7/seed: 7\nmesh: {h: 0.05}/' "mesh.h: must be in [shapes.h = 0.1, 0.5]"
 expect grid_size       's/grid_size: 16/grid_size: 100000/'                "representations.grid_size"
 expect grid_flag       's/grid_size: 16/grid: maybe/'                      "representations.grid"
 expect split_sum       's/^seed: 7/seed: 7\nsplit: {train: 0.9, val: 0.2, test: 0.1}/' "split"
