@@ -7,6 +7,8 @@ void parse_solver_block(const YamlBlock& sol, solver::SolverOptions& s) {
   if (!(s.rtol > 0 && s.rtol < 1)) sol.fail("rtol", "must be in (0, 1)");
   if (sol.has("max_newton")) s.max_newton = int(sol.integer("max_newton"));
   if (s.max_newton < 1) sol.fail("max_newton", "must be >= 1");
+  if (sol.has("lag")) s.lag = int(sol.integer("lag"));
+  if (s.lag < 0 || s.lag > 20) sol.fail("lag", "must be in [0, 20] (0: a fresh factorisation every Newton iteration)");
   if (sol.has("max_increments")) s.max_increments = int(sol.integer("max_increments"));
   if (s.max_increments < 1) sol.fail("max_increments", "must be >= 1");
   if (sol.has("target_rtol")) s.target_rtol = sol.number("target_rtol");
@@ -24,7 +26,7 @@ void parse_solver_block(const YamlBlock& sol, solver::SolverOptions& s) {
   if (sol.has("fallback")) s.fallback = sol.boolean("fallback");
   if (sol.has("branch_switches")) s.branch_switches = int(sol.integer("branch_switches"));
   if (s.branch_switches < 0 || s.branch_switches > 10) sol.fail("branch_switches", "must be in [0, 10]");
-  sol.allowed("rtol, max_newton, max_increments, target_rtol, control, path_rtol, newton_budget, fallback, "
+  sol.allowed("rtol, max_newton, lag, max_increments, target_rtol, control, path_rtol, newton_budget, fallback, "
               "branch_switches");
   sol.check_all_used();
 }

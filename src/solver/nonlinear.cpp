@@ -111,6 +111,7 @@ PetscErrorCode NonlinearSolver::form_jacobian(SNES snes, Vec x, Mat, Mat P, void
   auto* self = static_cast<NonlinearSolver*>(ctx);
   return guarded([&] {
     if (!self->problem_.jacobian(x, P)) HS_PETSC(SNESSetJacobianDomainError(snes));
+    ++self->factorisations_;  // the SNES's KSP factorises it next
   });
 }
 
@@ -258,6 +259,7 @@ SolveResult NonlinearSolver::solve(double target) {
 double NonlinearSolver::linear_response() {
   HS_PETSC(VecCopy(u_, backup_));
   if (!problem_.jacobian(u_, J_)) return 0.0;
+  ++factorisations_;
   KSP ksp;
   HS_PETSC(SNESGetKSP(snes_, &ksp));
   HS_PETSC(KSPSetOperators(ksp, J_, J_));
@@ -268,6 +270,7 @@ double NonlinearSolver::linear_response() {
 
 TargetResult NonlinearSolver::solve_for_target(double target) {
   const double start = core::now_seconds();
+  const int factorisations_before = factorisations_;
   TargetResult t = opt_.control == Control::displacement ? follow_path(target, start)
                                                           : search_target(target, start);
   // (t.solves == 0: the path never started, e.g. no tangent at the initial state: no branch.)
@@ -291,6 +294,7 @@ TargetResult NonlinearSolver::solve_for_target(double target) {
   }
   t.seconds_total = core::now_seconds() - start;
   if (t.solves <= 1) t.seconds_first_solve = t.seconds_total;
+  t.factorisations = factorisations_ - factorisations_before;
   return t;
 }
 
@@ -328,6 +332,7 @@ bool NonlinearSolver::rest_response() {
     configure_direct_solver(ksp0_, problem_.comm(), problem_.space().dim());
     HS_PETSC(KSPSetFromOptions(ksp0_));
     HS_PETSC(KSPSetOperators(ksp0_, J0_, J0_));
+    ++factorisations_;  // once per problem
   }
   negative_pivots_ = -1;
   HS_PETSC(KSPSolve(ksp0_, problem_.load(), a_));
@@ -340,6 +345,7 @@ bool NonlinearSolver::rest_response() {
 bool NonlinearSolver::tangent_response() {
   negative_pivots_ = -1;
   if (!problem_.jacobian(u_, J_)) return false;
+  ++factorisations_;
   KSP ksp;
   HS_PETSC(SNESGetKSP(snes_, &ksp));
   HS_PETSC(KSPSetOperators(ksp, J_, J_));
@@ -411,9 +417,10 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
     why = "inadmissible state (det F <= 0)";
     return false;
   }
-  PetscReal rn, rn0;
+  PetscReal rn, rn0, rn_prev = 0;
   HS_PETSC(VecNorm(r_, NORM_2, &rn));
   rn0 = rn;
+  int reused = 0;  // iterations since the last factorisation (lag)
   for (int k = 0;; ++k) {
     const double m = control_direction(u_, a_, c_);
     const double g = m - d;
@@ -421,7 +428,15 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
       why = "non-finite residual";
       return false;
     }
-    if (rn <= opt_.atol + rtol * std::abs(s_) * fnorm && std::abs(g) <= gtol) return true;
+    if (rn <= opt_.atol + rtol * std::abs(s_) * fnorm && std::abs(g) <= gtol) {
+      // A lagged factorisation is of an earlier iterate: the final state's inertia (and the
+      // next predictor, a_) need the tangent at this state.
+      if (reused > 0 && rtol <= opt_.rtol && !tangent_response()) {
+        why = "tangent factorisation or solve failed";
+        return false;
+      }
+      return true;
+    }
     if (k == opt_.max_newton) {
       why = "no convergence in " + std::to_string(opt_.max_newton) + " Newton iterations";
       return false;
@@ -435,10 +450,17 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
       return false;
     }
     ++its;
-    if (!tangent_response()) {
-      why = "tangent factorisation or solve failed";
-      return false;
+    // Modified Newton (lag > 0): keep the factorisation while it still contracts fast.
+    if (opt_.lag > 0 && k > 0 && reused < opt_.lag && rn <= 0.1 * rn_prev) {
+      ++reused;
+    } else {
+      reused = 0;
+      if (!tangent_response()) {
+        why = "tangent factorisation or solve failed";
+        return false;
+      }
     }
+    rn_prev = rn;
     // Bordered system: K du - dalpha f = -R, c . du = d - m, with K^-1 f = a and K^-1 R = b.
     HS_PETSC(KSPSolve(ksp, r_, b_));
     PetscReal ca, cb;
@@ -540,6 +562,7 @@ bool NonlinearSolver::minimise(double s, int& its, std::string& why) {
     }
     if (mu > 0) HS_PETSC(MatShift(J_, mu));
     HS_PETSC(KSPSetOperators(ksp, J_, J_));
+    ++factorisations_;
     HS_PETSC(KSPSolve(ksp, r_, du_));
     KSPConvergedReason kr;
     HS_PETSC(KSPGetConvergedReason(ksp, &kr));

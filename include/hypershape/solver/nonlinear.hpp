@@ -76,6 +76,11 @@ struct SolverOptions {
   int branch_switches = 3;     ///< displacement control failed: leave the branch this often
   int max_halvings = 6;        ///< displacement control: failed increments in a row (then: fail)
   int max_newton = 12;         ///< Newton iterations per increment (then: smaller increment)
+  /// Lagged factorisations (modified Newton) in the displacement-control corrector: reuse the
+  /// last factorisation of the tangent for up to `lag` further iterations while the residual
+  /// falls at least tenfold per iteration; a converged final state is refactorised once for its
+  /// inertia (the stability check). 0: a fresh factorisation every iteration (default).
+  int lag = 0;
   int max_increments = 64;     ///< continuation increments per solve
   double min_increment = 1e-4; ///< smallest increment, relative to the requested change
   bool guard = true;           ///< energy objective + bt line search (else: full Newton steps)
@@ -106,6 +111,7 @@ struct TargetResult {
   int failed_increments = 0;
   int increments = 0;              ///< accepted increments (displacement control)
   int recovery_iterations = 0;     ///< Newton iterations spent in failed (discarded) increments
+  int factorisations = 0;          ///< numeric factorisations of a tangent (K(0) kept: 0 after the first)
   int negative_pivots = -1;        ///< of the last tangent factorisation (MUMPS LDL^T; -1: unknown)
   double seconds_first_solve = 0;  ///< linear response + the first nonlinear solve
   double seconds_total = 0;
@@ -192,6 +198,7 @@ class NonlinearSolver {
   double step_hint_ = 0;
   double s0_ = 0;       ///< load factor of the state a branch switch left (in v0_)
   int negative_pivots_ = -1;  ///< inertia of the last tangent_response() (-1: unknown)
+  int factorisations_ = 0;    ///< numeric factorisations so far (TargetResult::factorisations)
   bool user_atol_ = false;
 };
 
