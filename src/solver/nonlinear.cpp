@@ -111,7 +111,7 @@ PetscErrorCode NonlinearSolver::form_jacobian(SNES snes, Vec x, Mat, Mat P, void
   auto* self = static_cast<NonlinearSolver*>(ctx);
   return guarded([&] {
     if (!self->problem_.jacobian(x, P)) HS_PETSC(SNESSetJacobianDomainError(snes));
-    ++self->factorisations_;  // the SNES's KSP factorises it next
+    else ++self->factorisations_;  // the SNES's KSP factorises it next
   });
 }
 
