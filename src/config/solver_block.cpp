@@ -7,8 +7,12 @@ void parse_solver_block(const YamlBlock& sol, solver::SolverOptions& s) {
   if (!(s.rtol > 0 && s.rtol < 1)) sol.fail("rtol", "must be in (0, 1)");
   if (sol.has("max_newton")) s.max_newton = int(sol.integer("max_newton"));
   if (s.max_newton < 1) sol.fail("max_newton", "must be >= 1");
-  if (sol.has("lag")) s.lag = int(sol.integer("lag"));
-  if (s.lag < 0 || s.lag > 20) sol.fail("lag", "must be in [0, 20] (0: a fresh factorisation every Newton iteration)");
+  if (sol.has("factor_reuse")) s.tangent.reuse = sol.boolean("factor_reuse");
+  if (sol.has("krylov_budget")) s.tangent.krylov_budget = int(sol.integer("krylov_budget"));
+  if (s.tangent.krylov_budget < 0 || s.tangent.krylov_budget > 100000)
+    sol.fail("krylov_budget", "must be in [0, 100000] (Krylov iterations per factorisation; 0: by dimension)");
+  if (sol.has("krylov_rtol")) s.tangent.krylov_rtol = sol.number("krylov_rtol");
+  if (!(s.tangent.krylov_rtol > 0 && s.tangent.krylov_rtol < 1)) sol.fail("krylov_rtol", "must be in (0, 1)");
   if (sol.has("max_increments")) s.max_increments = int(sol.integer("max_increments"));
   if (s.max_increments < 1) sol.fail("max_increments", "must be >= 1");
   if (sol.has("target_rtol")) s.target_rtol = sol.number("target_rtol");
@@ -26,7 +30,7 @@ void parse_solver_block(const YamlBlock& sol, solver::SolverOptions& s) {
   if (sol.has("fallback")) s.fallback = sol.boolean("fallback");
   if (sol.has("branch_switches")) s.branch_switches = int(sol.integer("branch_switches"));
   if (s.branch_switches < 0 || s.branch_switches > 10) sol.fail("branch_switches", "must be in [0, 10]");
-  sol.allowed("rtol, max_newton, lag, max_increments, target_rtol, control, path_rtol, newton_budget, fallback, "
+  sol.allowed("rtol, max_newton, factor_reuse, krylov_budget, krylov_rtol, max_increments, target_rtol, control, path_rtol, newton_budget, fallback, "
               "branch_switches");
   sol.check_all_used();
 }

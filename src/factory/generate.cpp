@@ -238,6 +238,7 @@ RunReport generate(MPI_Comm comm, const config::DatasetConfig& cfg, const Genera
         rep.solves += r.solves;
         rep.failed_increments += r.failed_increments;
         rep.recovery_iterations += r.recovery_iterations;
+        rep.linear += r.linear;
         if (!r.entry.ok)
           core::log_line(MPI_COMM_SELF, core::Verbosity::normal,
                          fmt::format("[generate] shape {} failed: {}", id, r.entry.failure.substr(0, 300)));
@@ -283,6 +284,9 @@ RunReport generate(MPI_Comm comm, const config::DatasetConfig& cfg, const Genera
   rep.solves = sum_roots(rep.solves);
   rep.failed_increments = sum_roots(rep.failed_increments);
   rep.recovery_iterations = sum_roots(rep.recovery_iterations);
+  for (std::int64_t* c : {&rep.linear.numeric_factorizations, &rep.linear.symbolic_factorizations,
+                          &rep.linear.krylov_iterations, &rep.linear.tangent_assemblies})
+    *c = sum_roots(*c);
   rep.shards_written = sum_roots(shards_written);
   const std::vector<std::string> phases = {"shape", "mesh", "setup", "solve", "alpha_search",
                                            "representations", "gather", "io"};
@@ -318,7 +322,11 @@ RunReport generate(MPI_Comm comm, const config::DatasetConfig& cfg, const Genera
                          {"per_second", (rep.loads_ok + rep.loads_failed) / std::max(1e-9, rep.seconds)}};
       j["solver"] = {{"newton_iterations", rep.newton_iterations}, {"nonlinear_solves", rep.solves},
                      {"failed_increments", rep.failed_increments},
-                     {"recovery_iterations", rep.recovery_iterations}};
+                     {"recovery_iterations", rep.recovery_iterations},
+                     {"numeric_factorizations", rep.linear.numeric_factorizations},
+                     {"symbolic_factorizations", rep.linear.symbolic_factorizations},
+                     {"krylov_iterations", rep.linear.krylov_iterations},
+                     {"tangent_assemblies", rep.linear.tangent_assemblies}};
       j["seconds"] = {{"wall", rep.seconds}, {"phases_summed_over_groups", rep.phase_seconds},
                       {"factorization_PCSetUp_summed_over_ranks", rep.factorization_seconds}};
       j["peak_rss_mib_per_rank"] = rss;
@@ -349,6 +357,11 @@ std::string report_table(const RunReport& r) {
   s += fmt::format("  Newton iterations {} in {} increments ({:.1f} per load case); {} failed increments "
                    "cost {} of them\n", r.newton_iterations, r.solves, r.newton_iterations / std::max(1.0, loads),
                    r.failed_increments, r.recovery_iterations);
+  const double ok = std::max<double>(1.0, double(r.loads_ok));
+  s += fmt::format("  per converged load case: {:.2f} numeric factorisations, {:.2f} symbolic, {:.1f} Krylov "
+                   "iterations, {:.1f} tangent assemblies\n", double(r.linear.numeric_factorizations) / ok,
+                   double(r.linear.symbolic_factorizations) / ok, double(r.linear.krylov_iterations) / ok,
+                   double(r.linear.tangent_assemblies) / ok);
   double total = 0;
   for (const auto& [k, v] : r.phase_seconds) total += v;
   s += "  phase              seconds   share\n";

@@ -276,6 +276,7 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
     recovery[L] = r.recovery_iterations;
     out.recovery_iterations += r.recovery_iterations;
     out.newton_iterations += r.newton_iterations;
+    out.linear += r.linear;
     out.solves += r.solves;
     out.failed_increments += r.failed_increments;
     bool ok = failure.empty() && r.converged;

@@ -10,6 +10,7 @@
 
 #include "hypershape/core/error.hpp"
 #include "hypershape/core/log.hpp"
+#include "log_events.hpp"
 
 namespace hypershape::solver {
 
@@ -24,28 +25,6 @@ PetscErrorCode guarded(F&& f) {
   } catch (const std::exception& e) {
     return PetscError(PETSC_COMM_SELF, __LINE__, "hypershape callback", __FILE__, PETSC_ERR_LIB,
                       PETSC_ERROR_INITIAL, "%s", e.what());
-  }
-}
-
-/// The tangent's linear solver: LDL^T, PETSc's own in 2D on one rank, MUMPS otherwise
-/// (options with the KSP's prefix still apply).
-void configure_direct_solver(KSP ksp, MPI_Comm comm, int dim) {
-  PC pc;
-  HS_PETSC(KSPSetType(ksp, KSPPREONLY));
-  HS_PETSC(KSPGetPC(ksp, &pc));
-  HS_PETSC(PCSetType(pc, PCCHOLESKY));
-  // 2D on one rank: PETSc's own sparse Cholesky (LDL^T without pivoting) in the quotient
-  // minimum degree ordering; measured 1.4x faster per load case than MUMPS on Random2D shapes,
-  // whose per-call overhead dominates at a few thousand unknowns. In 3D its non-supernodal
-  // factorisation is far slower than MUMPS (a Random3D load case took minutes), and a solver
-  // group of several ranks needs a parallel one: MUMPS. Both report the inertia.
-  PetscMPIInt ranks;
-  MPI_Comm_size(comm, &ranks);
-  if (ranks == 1 && dim == 2) {
-    HS_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERPETSC));
-    HS_PETSC(PCFactorSetMatOrderingType(pc, MATORDERINGQMD));
-  } else {
-    HS_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
   }
 }
 
@@ -89,6 +68,9 @@ NonlinearSolver::NonlinearSolver(const physics::Problem& problem, const SolverOp
   HS_PETSC(SNESGetKSP(snes_, &ksp));
   configure_direct_solver(ksp, problem.comm(), problem.space().dim());
   HS_PETSC(SNESSetFromOptions(snes_));
+  const char* ksp_prefix = nullptr;
+  HS_PETSC(KSPGetOptionsPrefix(ksp, &ksp_prefix));
+  tangent_ = std::make_unique<Tangent>(problem, opt.tangent, ksp_prefix ? ksp_prefix : "");
   PetscBool has_atol = PETSC_FALSE;
   HS_PETSC(PetscOptionsHasName(nullptr, prefix.empty() ? nullptr : prefix.c_str(), "-snes_atol",
                                &has_atol));
@@ -110,8 +92,9 @@ PetscErrorCode NonlinearSolver::form_function(SNES snes, Vec x, Vec f, void* ctx
 PetscErrorCode NonlinearSolver::form_jacobian(SNES snes, Vec x, Mat, Mat P, void* ctx) {
   auto* self = static_cast<NonlinearSolver*>(ctx);
   return guarded([&] {
+    ++self->snes_linear_.tangent_assemblies;
     if (!self->problem_.jacobian(x, P)) HS_PETSC(SNESSetJacobianDomainError(snes));
-    else ++self->factorisations_;  // the SNES's KSP factorises it next
+    else ++self->snes_linear_.numeric_factorizations;  // the SNES's KSP factorises it next
   });
 }
 
@@ -258,8 +241,9 @@ SolveResult NonlinearSolver::solve(double target) {
 
 double NonlinearSolver::linear_response() {
   HS_PETSC(VecCopy(u_, backup_));
+  ++snes_linear_.tangent_assemblies;
   if (!problem_.jacobian(u_, J_)) return 0.0;
-  ++factorisations_;
+  ++snes_linear_.numeric_factorizations;
   KSP ksp;
   HS_PETSC(SNESGetKSP(snes_, &ksp));
   HS_PETSC(KSPSetOperators(ksp, J_, J_));
@@ -270,7 +254,7 @@ double NonlinearSolver::linear_response() {
 
 TargetResult NonlinearSolver::solve_for_target(double target) {
   const double start = core::now_seconds();
-  const int factorisations_before = factorisations_;
+  const LinearCounters linear_before = linear_counters();
   TargetResult t = opt_.control == Control::displacement ? follow_path(target, start)
                                                           : search_target(target, start);
   // (t.solves == 0: the path never started, e.g. no tangent at the initial state: no branch.)
@@ -294,66 +278,40 @@ TargetResult NonlinearSolver::solve_for_target(double target) {
   }
   t.seconds_total = core::now_seconds() - start;
   if (t.solves <= 1) t.seconds_first_solve = t.seconds_total;
-  t.factorisations = factorisations_ - factorisations_before;
+  t.linear = linear_counters() - linear_before;
   return t;
 }
 
-int negative_eigenvalues(KSP ksp) {
-  PC pc;
-  PCType type;
-  HS_PETSC(KSPGetPC(ksp, &pc));
-  HS_PETSC(PCGetType(pc, &type));
-  if (!type || std::string(type) != PCCHOLESKY) return -1;
-  MatSolverType package;
-  Mat F;
-  HS_PETSC(PCFactorGetMatSolverType(pc, &package));
-  HS_PETSC(PCFactorGetMatrix(pc, &F));
-  const std::string p = package ? package : "";
-  PetscInt neg = -1, zero, pos;
-  if (p == MATSOLVERMUMPS) {
-    HS_PETSC(MatMumpsGetInfog(F, 12, &neg));
-  } else if (p == MATSOLVERPETSC) {
-    HS_PETSC(MatGetInertia(F, &neg, &zero, &pos));
-  }
-  return int(neg);
+LinearCounters NonlinearSolver::linear_counters() const {
+  LinearCounters n = tangent_->counters();
+  n += snes_linear_;
+  // The SNES's KSP analyses its pattern once, on its first factorisation.
+  if (snes_linear_.numeric_factorizations > 0) ++n.symbolic_factorizations;
+  return n;
 }
 
 bool NonlinearSolver::rest_response() {
-  if (!ksp0_) {
-    // Configured as the SNES's KSP, the same options (prefix) included.
-    KSP ksp;
-    const char* prefix = nullptr;
-    HS_PETSC(SNESGetKSP(snes_, &ksp));
-    HS_PETSC(KSPGetOptionsPrefix(ksp, &prefix));
-    J0_ = problem_.create_matrix();
-    if (!problem_.jacobian(u_, J0_)) return tangent_response();
-    HS_PETSC(KSPCreate(problem_.comm(), ksp0_.out()));
-    HS_PETSC(KSPSetOptionsPrefix(ksp0_, prefix));
-    configure_direct_solver(ksp0_, problem_.comm(), problem_.space().dim());
-    HS_PETSC(KSPSetFromOptions(ksp0_));
-    HS_PETSC(KSPSetOperators(ksp0_, J0_, J0_));
-    ++factorisations_;  // once per problem
-  }
+  if (!tangent_->use_rest_factor(u_)) return tangent_response(false);
   negative_pivots_ = -1;
-  HS_PETSC(KSPSolve(ksp0_, problem_.load(), a_));
-  KSPConvergedReason kr;
-  HS_PETSC(KSPGetConvergedReason(ksp0_, &kr));
-  if (kr > 0) negative_pivots_ = negative_eigenvalues(ksp0_);
-  return kr > 0;
+  if (!tangent_->apply_factor(problem_.load(), a_)) return false;
+  negative_pivots_ = tangent_->negative_eigenvalues();
+  return true;
 }
 
-bool NonlinearSolver::tangent_response() {
+bool NonlinearSolver::tangent_response(bool guess) {
   negative_pivots_ = -1;
-  if (!problem_.jacobian(u_, J_)) return false;
-  ++factorisations_;
-  KSP ksp;
-  HS_PETSC(SNESGetKSP(snes_, &ksp));
-  HS_PETSC(KSPSetOperators(ksp, J_, J_));
-  HS_PETSC(KSPSolve(ksp, problem_.load(), a_));
-  KSPConvergedReason kr;
-  HS_PETSC(KSPGetConvergedReason(ksp, &kr));
-  if (kr > 0) negative_pivots_ = negative_eigenvalues(ksp);
-  return kr > 0;
+  if (!tangent_->assemble(u_)) return false;
+  if (!tangent_->solve(problem_.load(), a_, guess)) return false;
+  // The inertia of K(u_) is known only from a factor of K(u_) itself.
+  if (tangent_->factor_is_current()) negative_pivots_ = tangent_->negative_eigenvalues();
+  return true;
+}
+
+bool NonlinearSolver::factorise_here() {
+  negative_pivots_ = -1;
+  if (!tangent_->assemble(u_) || !tangent_->factorise()) return false;
+  negative_pivots_ = tangent_->negative_eigenvalues();
+  return true;
 }
 
 double NonlinearSolver::control_direction(Vec u, Vec fallback, Vec c) {
@@ -409,18 +367,21 @@ double NonlinearSolver::control_direction(Vec u, Vec fallback, Vec c) {
 }
 
 bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why) {
-  KSP ksp;
-  HS_PETSC(SNESGetKSP(snes_, &ksp));
+  LogEvent event(events().corrector);
   const double fnorm = problem_.load_norm();
   const double gtol = 0.1 * opt_.target_rtol * std::abs(d);
   if (!problem_.residual(u_, s_, r_)) {
     why = "inadmissible state (det F <= 0)";
     return false;
   }
-  PetscReal rn, rn0, rn_prev = 0;
+  PetscReal rn, rn0;
   HS_PETSC(VecNorm(r_, NORM_2, &rn));
   rn0 = rn;
-  int reused = 0;  // iterations since the last factorisation (lag)
+  // Intermediate states of the path are converged loosely (path_rtol), and so are their Krylov
+  // solves: forcing 0.1 there (against krylov_rtol, 1e-3, throughout) cut the factorisations
+  // by a third and the Newton iterations by 3% on Random2D draws (3 shapes x 20 load cases).
+  constexpr double eta_path = 0.1;
+  tangent_->set_forcing(rtol > opt_.rtol ? std::max(eta_path, opt_.tangent.krylov_rtol) : opt_.tangent.krylov_rtol);
   for (int k = 0;; ++k) {
     const double m = control_direction(u_, a_, c_);
     const double g = m - d;
@@ -429,10 +390,10 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
       return false;
     }
     if (rn <= opt_.atol + rtol * std::abs(s_) * fnorm && std::abs(g) <= gtol) {
-      // A lagged factorisation is of an earlier iterate: the final state's inertia (and the
-      // next predictor, a_) need the tangent at this state.
-      if (reused > 0 && rtol <= opt_.rtol && !tangent_response()) {
-        why = "tangent factorisation or solve failed";
+      // The final state's stability check needs the inertia of its own tangent: with a kept
+      // factor (of an earlier state) it is factorised here, once per target solve.
+      if (rtol <= opt_.rtol && opt_.tangent.reuse && !factorise_here()) {
+        why = "tangent factorisation at the final state failed";
         return false;
       }
       return true;
@@ -450,19 +411,12 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
       return false;
     }
     ++its;
-    // Modified Newton (lag > 0): keep the factorisation while it still contracts fast.
-    if (opt_.lag > 0 && k > 0 && reused < opt_.lag && rn <= 0.1 * rn_prev) {
-      ++reused;
-    } else {
-      reused = 0;
-      if (!tangent_response()) {
-        why = "tangent factorisation or solve failed";
-        return false;
-      }
+    // Bordered system: K du - dalpha f = -R, c . du = d - m, with K^-1 f = a and K^-1 R = b
+    // (a from the previous iterate's as the initial guess: the tangent moved little).
+    if (!tangent_response(true) || !tangent_->solve(r_, b_, false)) {
+      why = "tangent factorisation or solve failed";
+      return false;
     }
-    rn_prev = rn;
-    // Bordered system: K du - dalpha f = -R, c . du = d - m, with K^-1 f = a and K^-1 R = b.
-    HS_PETSC(KSPSolve(ksp, r_, b_));
     PetscReal ca, cb;
     HS_PETSC(VecDot(c_, a_, &ca));
     HS_PETSC(VecDot(c_, b_, &cb));
@@ -509,26 +463,22 @@ double NonlinearSolver::softest_mode() {
   HS_PETSC(VecRestoreArray(xl, &x));
   HS_PETSC(DMLocalToGlobal(dm, xl, INSERT_VALUES, v_));
   HS_PETSC(DMRestoreLocalVector(dm, &xl));
-  KSP ksp;
-  HS_PETSC(SNESGetKSP(snes_, &ksp));
-  for (int k = 0; k < 8; ++k) {  // K is factored (tangent_response): 8 back-substitutions
+  for (int k = 0; k < 8; ++k) {  // K is factored (factorise_here): 8 back-substitutions
     PetscReal n;
     HS_PETSC(VecNormalize(v_, &n));
-    HS_PETSC(KSPSolve(ksp, v_, w_));
+    tangent_->apply_factor(v_, w_);
     HS_PETSC(VecCopy(w_, v_));
   }
   PetscReal vmax, vv, vkv;
   HS_PETSC(VecNorm(v_, NORM_INFINITY, &vmax));
   HS_PETSC(VecScale(v_, 1.0 / vmax));
-  HS_PETSC(MatMult(J_, v_, w_));
+  HS_PETSC(MatMult(tangent_->matrix(), v_, w_));
   HS_PETSC(VecDot(v_, w_, &vkv));
   HS_PETSC(VecDot(v_, v_, &vv));
   return vkv / vv;
 }
 
 bool NonlinearSolver::minimise(double s, int& its, std::string& why) {
-  KSP ksp;
-  HS_PETSC(SNESGetKSP(snes_, &ksp));
   const double fnorm = problem_.load_norm();
   double mu = 0, mu0 = 0;
   for (int k = 0;; ++k) {
@@ -548,26 +498,23 @@ bool NonlinearSolver::minimise(double s, int& its, std::string& why) {
       return false;
     }
     ++its;
-    if (!problem_.jacobian(u_, J_)) {
+    if (!tangent_->assemble(u_)) {
       why = "tangent could not be formed";
       return false;
     }
     if (mu0 == 0) {  // the shift's scale: the mean diagonal entry of the tangent
-      HS_PETSC(MatGetDiagonal(J_, w_));
+      HS_PETSC(MatGetDiagonal(tangent_->matrix(), w_));
       PetscReal sum;
       PetscInt n;
       HS_PETSC(VecSum(w_, &sum));
       HS_PETSC(VecGetSize(w_, &n));
       mu0 = 1e-3 * std::abs(sum) / double(n);
     }
-    if (mu > 0) HS_PETSC(MatShift(J_, mu));
-    HS_PETSC(KSPSetOperators(ksp, J_, J_));
-    ++factorisations_;
-    HS_PETSC(KSPSolve(ksp, r_, du_));
-    KSPConvergedReason kr;
-    HS_PETSC(KSPGetConvergedReason(ksp, &kr));
-    negative_pivots_ = kr > 0 ? negative_eigenvalues(ksp) : -1;
-    if (kr <= 0 || negative_pivots_ != 0) {  // indefinite (or failed): shift further
+    if (mu > 0) tangent_->shift(mu);
+    // The inertia decides the shift: a factorisation of this very (shifted) tangent.
+    const bool solved = tangent_->factorise() && tangent_->apply_factor(r_, du_);
+    negative_pivots_ = solved ? tangent_->negative_eigenvalues() : -1;
+    if (!solved || negative_pivots_ != 0) {  // indefinite (or failed): shift further
       mu = mu == 0 ? mu0 : 4 * mu;
       negative_pivots_ = -1;
       continue;
@@ -598,7 +545,8 @@ void NonlinearSolver::switch_branch(double target, double start, int attempt, Ta
   }
   // Leave the state along the softest mode of the tangent (the buckling mode at a
   // bifurcation, the near-null mode where Newton stalled), by the sign of lower energy.
-  bool ok = tangent_response();
+  LogEvent event(events().branch_switch);
+  bool ok = factorise_here();
   if (ok) {
     ++its;
     softest_mode();
@@ -648,7 +596,7 @@ TargetResult NonlinearSolver::follow_path(double target, double start, int spent
   // there doubles the factor memory (hundreds of MiB per rank at the 3D presets' sizes) for
   // one factorisation in about ten per load case.
   const bool cached_rest = d == 0 && problem_.space().dim() == 2;
-  if (!(cached_rest ? rest_response() : tangent_response())) {
+  if (!(cached_rest ? rest_response() : tangent_response(false))) {
     t.reason = "tangent factorisation or solve failed at the start";
     return t;
   }
@@ -698,6 +646,8 @@ TargetResult NonlinearSolver::follow_path(double target, double start, int spent
       ok = correct(d_next, last ? opt_.rtol : opt_.path_rtol, its, why);
     }
     if (t.solves == 1) t.seconds_first_solve = core::now_seconds() - start;
+    HS_PETSC(PetscInfo(snes_.get(), "path to %g: %g -> %g%s: %s in %d Newton its (alpha %g)\n", target, d, d_next,
+                       last ? " (last)" : "", ok ? "converged" : why.c_str(), its - its_before, s_));
     if (ok && last && negative_pivots_ > 0) {
       // An equilibrium whose tangent is indefinite: not a minimum of the energy, so not a state
       // the loaded body rests in (it buckles away from it). Only the final state is checked:

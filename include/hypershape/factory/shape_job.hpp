@@ -18,6 +18,7 @@
 #include "hypershape/io/dataset_shard.hpp"
 #include "hypershape/physics/gaussian_traction.hpp"
 #include "hypershape/physics/problem.hpp"
+#include "hypershape/solver/tangent.hpp"
 
 namespace hypershape::factory {
 
@@ -25,6 +26,7 @@ struct ShapeJobResult {
   io::ShardShape entry;      ///< significant on rank 0 of the group
   int loads_ok = 0, loads_failed = 0;
   int newton_iterations = 0, solves = 0, failed_increments = 0, recovery_iterations = 0;
+  solver::LinearCounters linear;  ///< factorisations, Krylov iterations, tangent assemblies
   std::int64_t n_dofs = 0;
   /// shape (draw + boundary + checks), mesh, setup, solve (first nonlinear solve of each load
   /// case), alpha_search (the further solves), representations, gather.

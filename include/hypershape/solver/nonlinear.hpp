@@ -46,19 +46,16 @@
 /// failed path (fallback: true; it rescued none of the failures there at twice their cost).
 #include <petscsnes.h>
 
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "hypershape/core/petsc_handle.hpp"
 #include "hypershape/physics/problem.hpp"
+#include "hypershape/solver/tangent.hpp"
 
 namespace hypershape::solver {
-
-/// The number of negative eigenvalues of the matrix a Cholesky (LDL^T) KSP has factored, by
-/// Sylvester's law of inertia: the negative pivots of MUMPS (INFOG(12)) or of PETSc's own
-/// factorisation (MatGetInertia). -1 where the KSP holds no such factorisation.
-int negative_eigenvalues(KSP ksp);
 
 /// How solve_for_target reaches its target max|u|.
 enum class Control {
@@ -76,11 +73,9 @@ struct SolverOptions {
   int branch_switches = 3;     ///< displacement control failed: leave the branch this often
   int max_halvings = 6;        ///< displacement control: failed increments in a row (then: fail)
   int max_newton = 12;         ///< Newton iterations per increment (then: smaller increment)
-  /// Lagged factorisations (modified Newton) in the displacement-control corrector: reuse the
-  /// last factorisation of the tangent for up to `lag` further iterations while the residual
-  /// falls at least tenfold per iteration; a converged final state is refactorised once for its
-  /// inertia (the stability check). 0: a fresh factorisation every iteration (default).
-  int lag = 0;
+  /// The displacement-controlled path's linear solves: Newton-Krylov on a kept factorisation
+  /// (default) or a fresh factorisation per Newton iteration (tangent.reuse = false).
+  TangentOptions tangent;
   int max_increments = 64;     ///< continuation increments per solve
   double min_increment = 1e-4; ///< smallest increment, relative to the requested change
   bool guard = true;           ///< energy objective + bt line search (else: full Newton steps)
@@ -111,7 +106,7 @@ struct TargetResult {
   int failed_increments = 0;
   int increments = 0;              ///< accepted increments (displacement control)
   int recovery_iterations = 0;     ///< Newton iterations spent in failed (discarded) increments
-  int factorisations = 0;          ///< numeric factorisations of a tangent (K(0) kept: 0 after the first)
+  LinearCounters linear;           ///< factorisations, Krylov iterations, assemblies of this solve
   int negative_pivots = -1;        ///< of the last tangent factorisation (MUMPS LDL^T; -1: unknown)
   double seconds_first_solve = 0;  ///< linear response + the first nonlinear solve
   double seconds_total = 0;
@@ -167,11 +162,17 @@ class NonlinearSolver {
   /// Node of the largest |u| and the vector c with c . v = (u_k / |u_k|) . v_k; when u = 0,
   /// picked from `fallback`. Returns |u_k|. Collective.
   double control_direction(Vec u, Vec fallback, Vec c);
-  /// Factorises K(u_) and solves K a_ = f_ext. False if the tangent cannot be formed.
-  bool tangent_response();
+  /// Assembles K(u_) and solves K a_ = f_ext (Tangent::solve: a kept factor, or a fresh one).
+  /// `guess`: a_ holds the response at a nearby state. False if the tangent cannot be formed.
+  bool tangent_response(bool guess);
   /// tangent_response() at rest (u = 0): K(0) is the same for every load case of the problem
-  /// (dead loads), so it is factorised once, in its own KSP, and kept (2D problems only).
+  /// (dead loads), so in 2D its factor is made once and kept (Tangent::use_rest_factor).
   bool rest_response();
+  /// Assembles and factorises K(u_) at a converged state: its inertia, exact, is the stability
+  /// check (negative_pivots_). False if the tangent cannot be formed or factorised.
+  bool factorise_here();
+  /// All linear-algebra work so far (the path's tangent and the SNES's).
+  LinearCounters linear_counters() const;
   /// After a failed path: leaves the state the path ended in (unstable, or where increments
   /// kept failing) along the tangent's softest mode, minimises the energy there at 0.7^attempt
   /// times its load (a stable state on another branch: past a subcritical bifurcation none is
@@ -189,8 +190,7 @@ class NonlinearSolver {
   SolverOptions opt_;
   core::SNESH snes_;
   core::MatH J_;
-  core::KSPH ksp0_;  ///< K(0), factorised once (rest_response)
-  core::MatH J0_;
+  std::unique_ptr<Tangent> tangent_;  ///< the path's tangent, its factors and Krylov solver
   core::VecH u_, backup_, r_;
   core::VecH a_, a0_, b_, c_, du_, w_, v_, v0_;  ///< displacement-control work vectors
   double s_ = 0;        ///< load factor of the current state
@@ -198,7 +198,7 @@ class NonlinearSolver {
   double step_hint_ = 0;
   double s0_ = 0;       ///< load factor of the state a branch switch left (in v0_)
   int negative_pivots_ = -1;  ///< inertia of the last tangent_response() (-1: unknown)
-  int factorisations_ = 0;    ///< numeric factorisations so far (TargetResult::factorisations)
+  LinearCounters snes_linear_;  ///< factorisations of the SNES's own KSP (load control)
   bool user_atol_ = false;
 };
 

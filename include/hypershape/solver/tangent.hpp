@@ -1,0 +1,120 @@
+#pragma once
+/// The tangent of a Problem and the factorisations kept for it: the piece of the nonlinear
+/// solver that owns every linear solve of the displacement-controlled path.
+///
+/// Newton-Krylov on a kept factorisation. A Newton step needs K(u) x = b with K(u) the tangent
+/// at the current iterate. Factorising K(u) at every iterate (a direct Newton) is what made a
+/// load case cost 11-17 numeric factorisations. Here K(u) is assembled (cheap: a cell loop)
+/// and x found by GMRES on K(u), right-preconditioned by the LDL^T factor of a tangent K(u_f)
+/// at an earlier state u_f. Near u_f the preconditioned operator is close to the identity and
+/// GMRES converges in a few iterations, each one triangular solve and one sparse product.
+///
+/// Refresh ("rent or buy"): one factorisation costs as much as `budget` Krylov iterations
+/// (measured: a triangular solve is ~1/25 of a numeric factorisation in 2D at a few thousand
+/// unknowns, 1/30-1/100 and more in 3D). A new factorisation of the current K(u) is bought when
+/// the Krylov iterations spent since the last one reach the budget, or when a solve does not
+/// converge within what is left of it. Both rules count iterations, never seconds: the
+/// sequence of factorisations, and so the data, is the same on every run.
+///
+/// Slots: the factor in use is either the work factor (refreshed as above) or, in 2D, the
+/// factor of K(0) (the state every load case starts from; dead loads, so the same for every
+/// load case of the problem), made once per problem and kept. In 3D a second MUMPS factor would
+/// double the factor memory, so a load case starts from whatever work factor the last one left.
+///
+/// Counters (numeric and symbolic factorisations, Krylov iterations, tangent assemblies) are
+/// counted where they happen; log events make -log_view show the split.
+#include <petscksp.h>
+
+#include <cstdint>
+#include <string>
+
+#include "hypershape/core/petsc_handle.hpp"
+#include "hypershape/physics/problem.hpp"
+
+namespace hypershape::solver {
+
+/// Linear-algebra work of a solve, counted where it happens.
+struct LinearCounters {
+  std::int64_t numeric_factorizations = 0;
+  std::int64_t symbolic_factorizations = 0;
+  std::int64_t krylov_iterations = 0;
+  std::int64_t tangent_assemblies = 0;
+  LinearCounters& operator+=(const LinearCounters& o);
+  LinearCounters operator-(const LinearCounters& o) const;
+};
+
+struct TangentOptions {
+  /// Newton-Krylov on a kept factorisation (default). false: a direct solve with a fresh
+  /// factorisation of every assembled tangent (the former solver; data bit for bit as before).
+  bool reuse = true;
+  /// Krylov iterations a factorisation may cost before the current tangent is factorised anew
+  /// (0: by dimension, 2D 25, 3D 60; measured with bench_solver and scripts/bench_generate.sh).
+  int krylov_budget = 0;
+  /// Relative tolerance of each Krylov solve (the inexact Newton forcing term).
+  double krylov_rtol = 1e-3;
+};
+
+/// The number of negative eigenvalues of the matrix a Cholesky (LDL^T) KSP has factored, by
+/// Sylvester's law of inertia: the negative pivots of MUMPS (INFOG(12)) or of PETSc's own
+/// factorisation (MatGetInertia). -1 where the KSP holds no such factorisation.
+int negative_eigenvalues(KSP ksp);
+
+/// Sets a KSP to LDL^T: PETSc's own (qmd ordering) in 2D on one rank, MUMPS otherwise (options
+/// with the KSP's prefix still apply when the caller calls KSPSetFromOptions).
+void configure_direct_solver(KSP ksp, MPI_Comm comm, int dim);
+
+class Tangent {
+ public:
+  /// Collective over the problem's communicator. `prefix`: options prefix of the factor KSPs
+  /// (as the SNES's, so -pc_factor_mat_solver_type etc. apply).
+  Tangent(const physics::Problem& problem, const TangentOptions& opt, const std::string& prefix);
+  Tangent(const Tangent&) = delete;
+  Tangent& operator=(const Tangent&) = delete;
+
+  /// K(u) into matrix() (not factorised). False (every rank) if det F <= 0 somewhere. Collective.
+  bool assemble(Vec u);
+  /// Shifts the assembled tangent: K + mu I (inertia-corrected Newton). Collective.
+  void shift(double mu);
+  /// Factorises the assembled tangent into the work factor, which becomes the one in use.
+  /// False if the factorisation failed. Collective.
+  bool factorise();
+  /// 2D: makes the factor of K(0) the one in use (assembled at `rest` and factorised on the first
+  /// call only). 3D: nothing; returns false. Collective.
+  bool use_rest_factor(Vec rest);
+  /// Solves K(u) x = b for the assembled tangent (x: initial guess if `guess`). Reuse: GMRES
+  /// preconditioned by the factor in use, refreshed by the budget rule; otherwise a fresh
+  /// factorisation and a direct solve. False if no solve succeeded. Collective.
+  bool solve(Vec b, Vec x, bool guess);
+  /// Applies the inverse of the factor in use: y = F^-1 x (no Krylov). Collective.
+  bool apply_factor(Vec x, Vec y);
+  /// Inertia of the factor in use; -1 unknown. Exact for K(u) only if factor_is_current().
+  int negative_eigenvalues() const;
+  /// The factor in use is of the assembled tangent (no assembly since the factorisation).
+  bool factor_is_current() const { return current_; }
+  Mat matrix() const { return J_.get(); }
+  const LinearCounters& counters() const { return n_; }
+  const TangentOptions& options() const { return opt_; }
+  /// The relative tolerance of the next Krylov solves (the inexact Newton forcing term).
+  void set_forcing(double rtol) { forcing_ = rtol; }
+
+ private:
+  KSP factor_ksp() const { return use_rest_ ? rest_ksp_.get() : work_ksp_.get(); }
+  bool krylov_solve(Vec b, Vec x, bool guess, int max_its, bool& converged);
+  static PetscErrorCode apply_shell(PC pc, Vec x, Vec y);
+
+  const physics::Problem& problem_;
+  TangentOptions opt_;
+  core::MatH J_;        ///< the assembled tangent K(u) (the Krylov operator)
+  core::MatH F_;        ///< copy of the tangent the work factor is of
+  core::MatH F0_;       ///< K(0), 2D
+  core::KSPH work_ksp_, rest_ksp_;  ///< preonly LDL^T of F_ and F0_
+  core::KSPH krylov_;   ///< GMRES on J_, right-preconditioned by the factor in use (PC shell)
+  bool use_rest_ = false;
+  bool current_ = false;
+  bool work_factored_ = false;
+  double forcing_ = 1e-3;
+  int since_factor_ = 0;  ///< Krylov iterations spent on the factor in use
+  LinearCounters n_;
+};
+
+}  // namespace hypershape::solver

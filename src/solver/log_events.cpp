@@ -1,0 +1,25 @@
+#include "log_events.hpp"
+
+#include "hypershape/core/error.hpp"
+
+namespace hypershape::solver {
+
+const Events& events() {
+  static const Events e = [] {
+    PetscClassId cls;
+    HS_PETSC(PetscClassIdRegister("hypershape solver", &cls));
+    Events r{};
+    HS_PETSC(PetscLogEventRegister("HSTangentAsm", cls, &r.tangent_assembly));
+    HS_PETSC(PetscLogEventRegister("HSFactor", cls, &r.factorisation));
+    HS_PETSC(PetscLogEventRegister("HSFactorSolve", cls, &r.factor_solve));
+    HS_PETSC(PetscLogEventRegister("HSKrylov", cls, &r.krylov));
+    HS_PETSC(PetscLogEventRegister("HSPredictor", cls, &r.predictor));
+    HS_PETSC(PetscLogEventRegister("HSCorrector", cls, &r.corrector));
+    HS_PETSC(PetscLogEventRegister("HSBranchSwitch", cls, &r.branch_switch));
+    HS_PETSC(PetscLogEventRegister("HSLoadControl", cls, &r.load_control));
+    return r;
+  }();
+  return e;
+}
+
+}  // namespace hypershape::solver

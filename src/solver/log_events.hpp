@@ -1,0 +1,30 @@
+#pragma once
+/// PETSc log events of the nonlinear solver's pieces, so that -log_view explains a load case:
+/// HSTangentAsm (tangent assemblies), HSFactor (numeric factorisations, symbolic included on
+/// the first), HSFactorSolve (direct solves with a factor), HSKrylov (Newton-Krylov solves),
+/// HSPredictor / HSCorrector (the displacement-controlled path), HSBranchSwitch, HSLoadControl.
+#include <petsclog.h>
+
+namespace hypershape::solver {
+
+struct Events {
+  PetscLogEvent tangent_assembly, factorisation, factor_solve, krylov, predictor, corrector,
+      branch_switch, load_control;
+};
+
+/// Registered on first use (PETSc must be initialised). Not collective.
+const Events& events();
+
+/// Begins an event for the lifetime of the scope.
+class LogEvent {
+ public:
+  explicit LogEvent(PetscLogEvent e) : e_(e) { PetscLogEventBegin(e_, 0, 0, 0, 0); }
+  ~LogEvent() { PetscLogEventEnd(e_, 0, 0, 0, 0); }
+  LogEvent(const LogEvent&) = delete;
+  LogEvent& operator=(const LogEvent&) = delete;
+
+ private:
+  PetscLogEvent e_;
+};
+
+}  // namespace hypershape::solver
