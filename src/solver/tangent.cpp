@@ -27,73 +27,19 @@ LinearCounters LinearCounters::operator-(const LinearCounters& o) const {
   return d;
 }
 
-int negative_eigenvalues(KSP ksp) {
-  PC pc;
-  PCType type;
-  HS_PETSC(KSPGetPC(ksp, &pc));
-  HS_PETSC(PCGetType(pc, &type));
-  if (!type || std::string(type) != PCCHOLESKY) return -1;
-  MatSolverType package;
-  Mat F;
-  HS_PETSC(PCFactorGetMatSolverType(pc, &package));
-  HS_PETSC(PCFactorGetMatrix(pc, &F));
-  const std::string p = package ? package : "";
-  PetscInt neg = -1, zero, pos;
-  if (p == MATSOLVERMUMPS) {
-    HS_PETSC(MatMumpsGetInfog(F, 12, &neg));
-  } else if (p == MATSOLVERPETSC) {
-    HS_PETSC(MatGetInertia(F, &neg, &zero, &pos));
-  }
-  return int(neg);
-}
-
-void configure_direct_solver(KSP ksp, MPI_Comm comm, int dim) {
-  PC pc;
-  HS_PETSC(KSPSetType(ksp, KSPPREONLY));
-  HS_PETSC(KSPGetPC(ksp, &pc));
-  HS_PETSC(PCSetType(pc, PCCHOLESKY));
-  // 2D on one rank: PETSc's own sparse Cholesky (LDL^T without pivoting) in the quotient
-  // minimum degree ordering; measured 1.4x faster per load case than MUMPS on Random2D shapes,
-  // whose per-call overhead dominates at a few thousand unknowns. In 3D its non-supernodal
-  // factorisation is far slower than MUMPS (a Random3D load case took minutes), and a solver
-  // group of several ranks needs a parallel one: MUMPS. Both report the inertia.
-  PetscMPIInt ranks;
-  MPI_Comm_size(comm, &ranks);
-  if (ranks == 1 && dim == 2) {
-    HS_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERPETSC));
-    HS_PETSC(PCFactorSetMatOrderingType(pc, MATORDERINGQMD));
-  } else {
-    HS_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
-  }
-}
-
 namespace {
 
-core::KSPH make_factor_ksp(const physics::Problem& p, const std::string& prefix, Mat A) {
-  core::KSPH ksp;
-  HS_PETSC(KSPCreate(p.comm(), ksp.out()));
-  if (!prefix.empty()) HS_PETSC(KSPSetOptionsPrefix(ksp, prefix.c_str()));
-  configure_direct_solver(ksp, p.comm(), p.space().dim());
-  HS_PETSC(KSPSetFromOptions(ksp));
-  HS_PETSC(KSPSetOperators(ksp, A, A));
-  return ksp;
-}
-
-bool solved(KSP ksp) {
-  KSPConvergedReason r;
-  HS_PETSC(KSPGetConvergedReason(ksp, &r));
-  return r > 0;
-}
+/// Converged, or stopped at its iteration limit (then a factorisation of this tangent follows).
+bool usable(KSPConvergedReason r) { return r > 0 || r == KSP_DIVERGED_ITS; }
 
 }  // namespace
 
 Tangent::Tangent(const physics::Problem& problem, const TangentOptions& opt, const std::string& prefix)
-    : problem_(problem), opt_(opt) {
+    : problem_(problem), opt_(opt), prefix_(prefix) {
   if (opt_.krylov_budget <= 0) opt_.krylov_budget = problem.space().dim() == 2 ? 25 : 60;
   forcing_ = opt_.krylov_rtol;
   J_ = problem.create_matrix();
-  F_ = problem.create_matrix();
-  work_ksp_ = make_factor_ksp(problem, prefix, F_);
+  work_ = std::make_unique<LdltFactor>(problem, prefix);
   HS_PETSC(KSPCreate(problem.comm(), krylov_.out()));
   HS_PETSC(KSPSetOptionsPrefix(krylov_, (prefix + "tangent_").c_str()));
   HS_PETSC(KSPSetType(krylov_, KSPGMRES));
@@ -115,7 +61,11 @@ PetscErrorCode Tangent::apply_shell(PC pc, Vec x, Vec y) {
   PetscFunctionBeginUser;
   PetscCall(PCShellGetContext(pc, &ctx));
   auto* self = static_cast<Tangent*>(ctx);
-  PetscCall(KSPSolve(self->factor_ksp(), x, y));
+  try {
+    if (!self->factor().solve(x, y)) PetscCall(VecSet(y, PETSC_INFINITY));  // the Krylov solve then fails
+  } catch (const std::exception& e) {
+    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_LIB, "%s", e.what());
+  }
   PetscFunctionReturn(0);
 }
 
@@ -133,41 +83,28 @@ void Tangent::shift(double mu) {
 
 bool Tangent::factorise() {
   LogEvent e(events().factorisation);
-  HS_PETSC(MatCopy(J_, F_, SAME_NONZERO_PATTERN));
-  if (!work_factored_) ++n_.symbolic_factorizations;
+  if (!work_->factored()) ++n_.symbolic_factorizations;  // the analysis, on the first only
   ++n_.numeric_factorizations;
-  work_factored_ = true;
   use_rest_ = false;
   since_factor_ = 0;
-  // KSPSetOperators marks the new values; PCSetUp factorises now (not at the first solve), so
-  // that a failed factorisation is seen here and the event times it.
-  PC pc;
-  PCFailedReason why;
-  HS_PETSC(KSPSetOperators(work_ksp_, F_, F_));
-  HS_PETSC(KSPGetPC(work_ksp_, &pc));
-  HS_PETSC(PCSetUp(pc));
-  HS_PETSC(PCGetFailedReason(pc, &why));
-  current_ = why == PC_NOERROR;
+  current_ = work_->factorise(J_);
   return current_;
 }
 
 bool Tangent::use_rest_factor(Vec rest) {
   if (problem_.space().dim() != 2) return false;
-  if (!rest_ksp_) {
+  if (!rest_) {
     LogEvent e(events().factorisation);
-    F0_ = problem_.create_matrix();
+    J0_ = problem_.create_matrix();
     ++n_.tangent_assemblies;
-    if (!problem_.jacobian(rest, F0_)) return false;
-    rest_ksp_ = make_factor_ksp(problem_, [&] {
-      const char* p = nullptr;
-      HS_PETSC(KSPGetOptionsPrefix(work_ksp_, &p));
-      return std::string(p ? p : "");
-    }(), F0_);
-    PC pc;
-    HS_PETSC(KSPGetPC(rest_ksp_, &pc));
-    HS_PETSC(PCSetUp(pc));
+    if (!problem_.jacobian(rest, J0_)) return false;
+    rest_ = std::make_unique<LdltFactor>(problem_, prefix_);
     ++n_.symbolic_factorizations;
     ++n_.numeric_factorizations;  // once per problem
+    if (!rest_->factorise(J0_)) {
+      rest_.reset();
+      return false;
+    }
   }
   use_rest_ = true;
   current_ = false;
@@ -177,15 +114,10 @@ bool Tangent::use_rest_factor(Vec rest) {
 
 bool Tangent::apply_factor(Vec x, Vec y) {
   LogEvent e(events().factor_solve);
-  KSP ksp = factor_ksp();
-  HS_PETSC(KSPSolve(ksp, x, y));
-  return solved(ksp);
+  return factor().solve(x, y);
 }
 
-int Tangent::negative_eigenvalues() const {
-  if (!use_rest_ && !work_factored_) return -1;
-  return solver::negative_eigenvalues(factor_ksp());
-}
+int Tangent::negative_eigenvalues() const { return factor().negative_eigenvalues(); }
 
 bool Tangent::krylov_solve(Vec b, Vec x, bool guess, int max_its, bool& converged) {
   LogEvent e(events().krylov);
@@ -203,17 +135,17 @@ bool Tangent::krylov_solve(Vec b, Vec x, bool guess, int max_its, bool& converge
   n_.krylov_iterations += its;
   since_factor_ += int(its);
   converged = r > 0;
-  return r > 0 || r == KSP_DIVERGED_ITS;
+  return usable(r);
 }
 
 bool Tangent::solve(Vec b, Vec x, bool guess) {
-  if (!opt_.reuse) {  // the former direct Newton: factorise every assembled tangent
+  if (!opt_.reuse) {  // a direct Newton: factorise every assembled tangent
     if (!current_ && !factorise()) return false;
     return apply_factor(b, x);
   }
   const int budget = opt_.krylov_budget;
   // Buy a factorisation once the rented (Krylov) work since the last one has cost as much.
-  const bool have_factor = use_rest_ || work_factored_;
+  const bool have_factor = use_rest_ || work_->factored();
   if (!current_ && (since_factor_ >= budget || !have_factor) && !factorise()) return false;
   bool converged = false;
   krylov_solve(b, x, guess, std::max(budget - since_factor_, 4), converged);

@@ -26,10 +26,12 @@
 #include <petscksp.h>
 
 #include <cstdint>
+#include <memory>
 #include <string>
 
 #include "hypershape/core/petsc_handle.hpp"
 #include "hypershape/physics/problem.hpp"
+#include "hypershape/solver/ldlt.hpp"
 
 namespace hypershape::solver {
 
@@ -44,24 +46,19 @@ struct LinearCounters {
 };
 
 struct TangentOptions {
-  /// Newton-Krylov on a kept factorisation (default). false: a direct solve with a fresh
-  /// factorisation of every assembled tangent (the former solver; data bit for bit as before).
-  bool reuse = true;
+  /// Newton-Krylov on a kept factorisation. false (default): a direct solve with a fresh
+  /// factorisation of every assembled tangent. Measured side by side (scripts/bench_versions.sh):
+  /// 2.3-2.7x fewer numeric factorisations, but no fewer seconds on Random2D (P1 h 0.04) nor on
+  /// Random3D (P2 mesh.h 0.2): with a nearly incompressible material the tangent turns with the
+  /// body, a factor of an earlier state preconditions it poorly (5-9 GMRES iterations per solve),
+  /// and the back-solves cost what the factorisations saved.
+  bool reuse = false;
   /// Krylov iterations a factorisation may cost before the current tangent is factorised anew
   /// (0: by dimension, 2D 25, 3D 60; measured with bench_solver and scripts/bench_generate.sh).
   int krylov_budget = 0;
   /// Relative tolerance of each Krylov solve (the inexact Newton forcing term).
   double krylov_rtol = 1e-3;
 };
-
-/// The number of negative eigenvalues of the matrix a Cholesky (LDL^T) KSP has factored, by
-/// Sylvester's law of inertia: the negative pivots of MUMPS (INFOG(12)) or of PETSc's own
-/// factorisation (MatGetInertia). -1 where the KSP holds no such factorisation.
-int negative_eigenvalues(KSP ksp);
-
-/// Sets a KSP to LDL^T: PETSc's own (qmd ordering) in 2D on one rank, MUMPS otherwise (options
-/// with the KSP's prefix still apply when the caller calls KSPSetFromOptions).
-void configure_direct_solver(KSP ksp, MPI_Comm comm, int dim);
 
 class Tangent {
  public:
@@ -98,20 +95,19 @@ class Tangent {
   void set_forcing(double rtol) { forcing_ = rtol; }
 
  private:
-  KSP factor_ksp() const { return use_rest_ ? rest_ksp_.get() : work_ksp_.get(); }
+  LdltFactor& factor() const { return use_rest_ ? *rest_ : *work_; }
   bool krylov_solve(Vec b, Vec x, bool guess, int max_its, bool& converged);
   static PetscErrorCode apply_shell(PC pc, Vec x, Vec y);
 
   const physics::Problem& problem_;
   TangentOptions opt_;
+  std::string prefix_;
   core::MatH J_;        ///< the assembled tangent K(u) (the Krylov operator)
-  core::MatH F_;        ///< copy of the tangent the work factor is of
-  core::MatH F0_;       ///< K(0), 2D
-  core::KSPH work_ksp_, rest_ksp_;  ///< preonly LDL^T of F_ and F0_
+  core::MatH J0_;       ///< K(0), 2D
+  std::unique_ptr<LdltFactor> work_, rest_;  ///< of the current tangent at factorise(); of K(0)
   core::KSPH krylov_;   ///< GMRES on J_, right-preconditioned by the factor in use (PC shell)
   bool use_rest_ = false;
   bool current_ = false;
-  bool work_factored_ = false;
   double forcing_ = 1e-3;
   int since_factor_ = 0;  ///< Krylov iterations spent on the factor in use
   LinearCounters n_;

@@ -1,0 +1,75 @@
+#pragma once
+/// One LDL^T factorisation of a symmetric tangent, kept for solves and for its inertia.
+///
+/// Two kinds, chosen once per problem:
+///  - blocked (2D, one rank, PETSc's own factorisation, block size 2): the tangent's values are
+///    scattered into a symmetric block matrix (SBAIJ, 2x2 blocks, one per node) in a fill-reducing
+///    ordering of the nodes (approximate minimum degree on the node graph, computed once), and
+///    factored by PETSc's blocked U^T D U kernel. Measured on the disk (P1 h 0.04, 4.7k unknowns):
+///    numeric factorisation 2.3-3.6x faster and triangular solves 2.3x faster than the scalar
+///    factorisation of the AIJ matrix in the qmd ordering, with as many nonzeros in the factor.
+///    PETSc 3.18 has no MatGetInertia for 2x2 blocks: the inertia is counted from the 2x2
+///    diagonal blocks of D (stored inverted; a block and its inverse have the same inertia), by
+///    Sylvester's law, tested against dense eigenvalues and MUMPS.
+///  - general (3D, solver groups, or another factorisation asked for in the options): a copy of
+///    the matrix factored by a preonly Cholesky KSP (configure_direct_solver; the KSP's options
+///    prefix applies), inertia from MUMPS's INFOG(12) or MatGetInertia.
+#include <petscksp.h>
+
+#include <string>
+#include <vector>
+
+#include "hypershape/core/petsc_handle.hpp"
+#include "hypershape/physics/problem.hpp"
+
+namespace hypershape::solver {
+
+/// The number of negative eigenvalues of the matrix a Cholesky (LDL^T) KSP has factored, by
+/// Sylvester's law of inertia: the negative pivots of MUMPS (INFOG(12)) or of PETSc's own
+/// factorisation (MatGetInertia; 2x2 blocks: from D). -1 where the KSP holds no such factorisation.
+int negative_eigenvalues(KSP ksp);
+
+/// Sets a KSP to LDL^T: PETSc's own (qmd ordering) in 2D on one rank, MUMPS otherwise (options
+/// with the KSP's prefix still apply when the caller calls KSPSetFromOptions).
+void configure_direct_solver(KSP ksp, MPI_Comm comm, int dim);
+
+class LdltFactor {
+ public:
+  /// Collective. `prefix`: options prefix of the factor's KSP.
+  LdltFactor(const physics::Problem& problem, const std::string& prefix);
+  LdltFactor(const LdltFactor&) = delete;
+  LdltFactor& operator=(const LdltFactor&) = delete;
+
+  /// Factorises A (the problem's matrix layout); the analysis is done on the first call only.
+  /// False if the factorisation failed (e.g. a zero pivot). Collective.
+  bool factorise(Mat A);
+  /// x = A^-1 b for the A last factorised. False if the solve failed. Collective.
+  bool solve(Vec b, Vec x);
+  /// Negative eigenvalues of the A last factorised; -1 unknown. Collective.
+  int negative_eigenvalues() const;
+  bool factored() const { return factored_; }
+  bool blocked() const { return blocked_; }
+  /// The factor's KSP (preonly Cholesky) and the matrix it factors.
+  KSP ksp() const { return ksp_.get(); }
+
+ private:
+  void set_up_blocked(Mat A);
+  void scatter_values(Mat A);
+  /// Blocked kind: GMRES on F_ preconditioned by the factor where the solve lost digits.
+  void refine();
+  static PetscErrorCode apply_factor(PC pc, Vec x, Vec y);
+
+  bool blocked_ = false;
+  bool factored_ = false;
+  bool analysed_ = false;
+  core::MatH F_;    ///< the matrix factored: a copy of A (general) or its blocked permutation
+  core::KSPH ksp_;
+  // Blocked kind: old scalar index of new scalar index i = 2 node[i / 2] + i % 2 ...
+  std::vector<PetscInt> old_of_new_;
+  /// ... and, per nonzero of A's CSR values, its position in F_'s values (-1: lower triangle).
+  std::vector<PetscInt> value_map_;
+  core::VecH xp_, yp_, rp_;  ///< b, x and the residual in the new ordering
+  core::KSPH refine_;
+};
+
+}  // namespace hypershape::solver

@@ -1,0 +1,100 @@
+#!/usr/bin/env bash
+# Two builds of hypershape side by side on the same dataset slice, alternately on 1 rank:
+# seconds per load case, numeric factorisations, Krylov and Newton iterations per load case
+# (counted by PETSc's own log: MatCholFctrNum, KSPGMRESOrthog), the converged share, and how
+# far the two datasets' displacements are apart on the load cases both converged.
+#   scripts/bench_versions.sh OTHER_HYPERSHAPE [SHAPES] [LOADS] [REPEATS]
+#   PRESET=random3d MESH='{degree: 2, h: 0.3}' scripts/bench_versions.sh /tmp/old/hypershape 4 25 1
+# Environment: PRESET (default random2d), MESH (a mesh: override, default the preset's),
+# SOLVER (a solver: override for this build only, e.g. '{factor_reuse: false}').
+# JSON: results/bench_versions.json. Build the other version with e.g.
+#   git worktree add /tmp/old HEAD~1 && (cd /tmp/old && scripts/setup.sh)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+other=${1:?usage: scripts/bench_versions.sh OTHER_HYPERSHAPE [SHAPES] [LOADS] [REPEATS]}
+shapes=${2:-20} loads=${3:-50} repeats=${4:-1}
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+slice() {  # $1: file, $2: extra solver block
+  {
+    echo "preset: ${PRESET:-random2d}"
+    echo "name: bench_versions"
+    echo "shapes: {count: $shapes}"
+    echo "loads: {count: $loads}"
+    echo "output: {shard_size: 4}"
+    if [ -n "${MESH:-}" ]; then echo "mesh: $MESH"; fi
+    if [ -n "$2" ]; then echo "solver: $2"; fi
+  } > "$1"
+}
+slice "$work/this.yaml" "${SOLVER:-}"
+slice "$work/other.yaml" ""
+for ((k = 0; k < repeats; ++k)); do
+  build/hypershape -q generate "$work/this.yaml" --progress 0 -o "$work/this-$k" -- -log_view ":$work/this-$k.log"
+  "$other" -q generate "$work/other.yaml" --progress 0 -o "$work/other-$k" -- -log_view ":$work/other-$k.log"
+  echo "run $((k + 1))/$repeats done" >&2
+done
+mkdir -p results
+/usr/bin/python3 - "$work" "$repeats" "$other" <<'PY'
+import glob, json, re, statistics, sys
+import h5py, numpy as np
+work, repeats, other = sys.argv[1], int(sys.argv[2]), sys.argv[3]
+
+def count(log, event):
+    for line in open(log):
+        if line.startswith(event + " "):
+            return int(line.split()[1])
+    return 0
+
+def run(tag, k):
+    rep = json.load(open(f"{work}/{tag}-{k}/reports/task-000-of-001.json"))
+    lc = rep["load_cases"]["converged"] + rep["load_cases"]["failed"]
+    log = f"{work}/{tag}-{k}.log"
+    return {"seconds_per_load_case": rep["seconds"]["wall"] / lc, "load_cases": lc,
+            "converged": rep["load_cases"]["converged"],
+            "numeric_factorizations_per_load_case": count(log, "MatCholFctrNum") / lc,
+            "krylov_iterations_per_load_case": count(log, "KSPGMRESOrthog") / lc,
+            "newton_iterations_per_load_case": rep["solver"]["newton_iterations"] / lc,
+            "factorization_seconds_per_load_case": rep["seconds"]["factorization_PCSetUp_summed_over_ranks"] / lc}
+
+runs = {t: [run(t, k) for k in range(repeats)] for t in ("this", "other")}
+med = {t: {key: statistics.median(r[key] for r in runs[t]) for key in runs[t][0]} for t in runs}
+
+# The datasets, load case by load case (first repeat): displacement of the cases both converged.
+diffs, only = [], {"this": 0, "other": 0}
+for fa in sorted(glob.glob(f"{work}/this-0/shards/*.h5")):
+    fb = fa.replace("/this-0/", "/other-0/")
+    with h5py.File(fa) as a, h5py.File(fb) as b:
+        for s in a["shapes"]:
+            if "loads" not in a["shapes"][s] or "loads" not in b["shapes"][s]:
+                continue
+            la, lb = a["shapes"][s]["loads"], b["shapes"][s]["loads"]
+            sa, sb = la["status"][:], lb["status"][:]
+            only["this"] += int(((sa == 1) & (sb != 1)).sum())
+            only["other"] += int(((sb == 1) & (sa != 1)).sum())
+            for i in np.where((sa == 1) & (sb == 1))[0]:
+                ua, ub = la["displacement"][i], lb["displacement"][i]
+                diffs.append(float(np.abs(ua - ub).max() / max(np.abs(ub).max(), 1e-300)))
+diffs = np.array(diffs)
+out = {"other": other, "repeats": repeats, "runs": runs, "medians": med,
+       "u_rel_diff": {"both_converged": int(diffs.size), "median": float(np.median(diffs)) if diffs.size else None,
+                      "max": float(diffs.max()) if diffs.size else None,
+                      "above_1e-6": int((diffs > 1e-6).sum())},
+       "converged_only_in": only}
+json.dump(out, open("results/bench_versions.json", "w"), indent=1)
+print(f"{runs['this'][0]['load_cases']} load cases per run, {repeats} run(s) each, alternated; medians:")
+print("| version | s / load case | numeric factorisations / case | Krylov its / case | Newton its / case | factorisation s / case | converged |")
+print("|---|---|---|---|---|---|---|")
+for t, name in (("this", "this build"), ("other", other)):
+    m = med[t]
+    print(f"| {name} | {m['seconds_per_load_case']:.4f} | {m['numeric_factorizations_per_load_case']:.2f} "
+          f"| {m['krylov_iterations_per_load_case']:.1f} | {m['newton_iterations_per_load_case']:.1f} "
+          f"| {m['factorization_seconds_per_load_case']:.4f} | {m['converged']}/{m['load_cases']} |")
+ratio = med["other"]["seconds_per_load_case"] / med["this"]["seconds_per_load_case"]
+print(f"speed-up (other / this, seconds per load case): {ratio:.2f}x")
+u = out["u_rel_diff"]
+print(f"displacement, load cases converged in both ({u['both_converged']}): max|u_this - u_other| / max|u_other| "
+      f"median {u['median']:.1e}, max {u['max']:.1e}; {u['above_1e-6']} above 1e-6 (another equilibrium of the same "
+      f"max|u|); converged only in this build: {only['this']}, only in the other: {only['other']}")
+print("JSON: results/bench_versions.json")
+PY
