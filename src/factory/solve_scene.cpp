@@ -32,7 +32,7 @@ std::optional<mesh::ClampRegion> clamp_of(const config::Scene& s) {
 
 }  // namespace
 
-SceneOutcome solve_scene(MPI_Comm comm, const config::Scene& scene_in) {
+SceneOutcome solve_scene(MPI_Comm comm, const config::Scene& scene_in, int repeats) {
   SceneOutcome o;
   config::Scene scene = scene_in;
   mesh::MeshData m;
@@ -84,22 +84,27 @@ SceneOutcome solve_scene(MPI_Comm comm, const config::Scene& scene_in) {
   }
   {
     auto t = o.times.scope("solve");
-    if (scene.target) {
-      auto r = nl->solve_for_target(*scene.target);
-      o.converged = r.converged;
-      o.reason = r.reason;
-      o.alpha = r.alpha;
-      o.newton_iterations = r.newton_iterations;
-      o.solves = r.solves;
-      o.failed_increments = r.failed_increments;
-    } else {
-      auto r = nl->solve(*scene.alpha);
-      o.converged = r.converged;
-      o.reason = r.reason;
-      o.alpha = r.load_factor;
-      o.newton_iterations = r.newton_iterations;
-      o.solves = 1;
-      o.failed_increments = r.failed_increments;
+    for (int rep = 0; rep < std::max(repeats, 1); ++rep) {
+      if (rep > 0) nl->reset();
+      const double t0 = core::now_seconds();
+      if (scene.target) {
+        auto r = nl->solve_for_target(*scene.target);
+        o.converged = r.converged;
+        o.reason = r.reason;
+        o.alpha = r.alpha;
+        o.newton_iterations = r.newton_iterations;
+        o.solves = r.solves;
+        o.failed_increments = r.failed_increments;
+      } else {
+        auto r = nl->solve(*scene.alpha);
+        o.converged = r.converged;
+        o.reason = r.reason;
+        o.alpha = r.load_factor;
+        o.newton_iterations = r.newton_iterations;
+        o.solves = 1;
+        o.failed_increments = r.failed_increments;
+      }
+      o.load_case_seconds.push_back(core::now_seconds() - t0);
     }
     o.max_displacement = problem->max_displacement(nl->solution());
     o.min_det_f = problem->min_det_f(nl->solution());
@@ -129,6 +134,7 @@ SceneOutcome solve_scene(MPI_Comm comm, const config::Scene& scene_in) {
                    {"newton_iterations", double(o.newton_iterations)}};
       if (scene.target) r.numbers["target"] = *scene.target;
       r.strings = {{"reason", o.reason}, {"source", scene.source}};
+      r.load_case_seconds = o.load_case_seconds;
     }
   }
   return o;
@@ -137,6 +143,10 @@ SceneOutcome solve_scene(MPI_Comm comm, const config::Scene& scene_in) {
 std::string summary_line(const SceneOutcome& o) {
   std::string times;
   for (auto& [k, v] : o.times.all()) times += fmt::format(" {} {:.3f}s", k, v);
+  if (o.load_case_seconds.size() > 1) {
+    times += " | load case s:";
+    for (double v : o.load_case_seconds) times += fmt::format(" {:.4f}", v);
+  }
   return fmt::format("{}D P{}: {} vertices, {} cells, {} dofs | {} | alpha {:.6g}, max|u| {:.6g}, min det F {:.3f} | "
                      "{} Newton iterations in {} solves ({} failed increments) |{}",
                      o.dim, o.degree, o.n_vertices, o.n_cells, o.n_dofs,
