@@ -7,7 +7,8 @@
 ///   /mesh/cells            n_cells x k      VTK-ordered node indices (k = 3, 6, 4 or 10)
 ///   /fields/displacement   n_nodes x dim    u at the nodes
 ///   /inputs/scene          string           the scene file as read
-///   /timings/load_case_seconds  repeats     seconds of each solve of the load case
+///   /timings/seconds       n_solves         seconds of each solve (target, alpha, ... with
+///                                           several: `hypershape solve --repeat/--targets`)
 ///   attributes on /: dim, degree, n_vertices, alpha, target, max_displacement, converged,
 ///                    reason, newton_iterations, hypershape_version
 #include <cstdint>
@@ -26,7 +27,7 @@ struct SolutionRecord {
   std::string scene_text;
   std::map<std::string, double> numbers;       ///< scalar attributes
   std::map<std::string, std::string> strings;  ///< string attributes
-  std::vector<double> load_case_seconds;       ///< /timings/load_case_seconds (if not empty)
+  std::map<std::string, std::vector<double>> timings;  ///< /timings/<name>, one entry per solve
 };
 
 /// Writes `path` (.h5) and `path` with .xdmf. Not collective: call on one rank. Throws
