@@ -1,0 +1,491 @@
+#!/usr/bin/python3
+"""A baseline users know: the same scene solved by hypershape and by DOLFINx, side by side.
+
+    scripts/bench_dolfinx.py [SCENE.yaml] [--case DEGREE:H ...] [--targets 0.1,0.2,...]
+                             [--repeat N] [--hypershape build/hypershape]
+
+For each case (element degree, mesh size h; default the disk at P1 h 0.04 and P2 h 0.08) it
+1. runs `hypershape solve SCENE --targets T1,... --repeat N+1` (the scene with mesh.h and
+   mesh.degree overridden): every target solved in turn, N+1 times over, each load case from
+   rest (u = 0) on one problem and solver, its own seconds per load case in /timings/;
+2. reads hypershape's mesh from that output (vertices and cells; the P2 nodes are the edge
+   midpoints of the straight-sided cells, as DOLFINx's P2 nodes are) into DOLFINx, and builds
+   the same discretisation: vector Lagrange of the same degree, the same cell quadrature
+   degree (2 degree - 1) and facet quadrature degree (2 degree + 2) as hypershape's
+   SpaceOptions defaults, the seed's Neo-Hookean energy (plane strain in 2D), the same clamp
+   (the boundary facets whose vertices all lie within r of p_D, all their nodes fixed), the
+   Gaussian traction alpha g phi(x - p_N) / I_N on the other boundary facets with I_N by the
+   same facet rule, residual and Jacobian by UFL `derivative` of the energy;
+3. checks that the two agree: DOLFINx solved at hypershape's alpha must give hypershape's
+   max|u| and nodal field (printed: relative differences);
+4. times DOLFINx the way the seed paper solves: per load case, from rest, a proportional
+   guess alpha_0 = target / max|K(0)^-1 f_ext| (K(0) factorised once per mesh), then a secant
+   search on alpha until |max|u| / target - 1| <= 1e-3, each alpha solved by DOLFINx's
+   NewtonSolver (MUMPS LU, convergence ||R|| <= 1e-9 ||alpha f_ext|| as hypershape) from the
+   previous converged state, with adaptive load continuation (halve the increment after a
+   failed Newton solve, double it after a success) where a full step fails;
+5. prints a markdown table and writes results/bench_dolfinx.json (every load case of both).
+
+Timings are warm on both sides: the first pass over the targets is discarded (hypershape's
+pays the symbolic factorisation and K(0); DOLFINx's JIT and set-up are outside any timing),
+and the median over the remaining N passes is reported. Each side's seconds per load case
+run from u = 0 to the converged target: the nonlinear solves, assembly, factorisations and
+the alpha search; not the mesh, the function space, the forms or the output.
+
+Optional and not part of CI: it needs Debian's python3-dolfinx (DOLFINx 0.5.2) and runs
+with /usr/bin/python3. Single process (1 MPI rank on each side); set OMP/BLAS threads to 1.
+"""
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+
+for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS"):
+    os.environ.setdefault(var, "1")
+
+
+def import_dolfinx():
+    """Imports DOLFINx and friends, or exits with a message saying how to get them."""
+    try:
+        import dolfinx  # noqa: F401
+        import dolfinx.fem.petsc  # noqa: F401
+        import dolfinx.nls.petsc  # noqa: F401
+        import ufl  # noqa: F401
+        from mpi4py import MPI  # noqa: F401
+        from petsc4py import PETSc  # noqa: F401
+    except ImportError as e:
+        # Debian's DOLFINx lives in /usr/bin/python3's path only (not a venv's or pyenv's).
+        if os.path.realpath(sys.executable) != os.path.realpath("/usr/bin/python3") and \
+                os.path.exists("/usr/bin/python3") and not os.environ.get("BENCH_DOLFINX_REEXEC"):
+            os.environ["BENCH_DOLFINX_REEXEC"] = "1"
+            os.execv("/usr/bin/python3", ["/usr/bin/python3", __file__] + sys.argv[1:])
+        sys.exit(f"bench_dolfinx: DOLFINx is not available ({e}).\n"
+                 "This optional benchmark needs Debian's python3-dolfinx (DOLFINx 0.5.2):\n"
+                 "    apt-get install -y --no-install-recommends python3-dolfinx\n"
+                 "and runs with /usr/bin/python3.")
+    try:
+        import h5py  # noqa: F401
+        import numpy  # noqa: F401
+        import yaml  # noqa: F401
+    except ImportError as e:
+        sys.exit(f"bench_dolfinx: {e}; install python3-h5py python3-numpy python3-yaml")
+
+
+# ----------------------------------------------------------------------------------------------
+# hypershape side
+
+
+def run_hypershape(exe, scene, degree, h, targets, passes, workdir, name):
+    """Writes the scene with mesh.h/degree overridden, runs `hypershape solve --targets
+    --repeat`, returns its output file."""
+    import yaml
+    s = dict(scene)
+    s["mesh"] = dict(s.get("mesh") or {})
+    s["mesh"]["h"] = h
+    s["mesh"]["degree"] = degree
+    s["load"] = {"target": targets[0]}
+    scene_path = workdir / f"{name}.yaml"
+    scene_path.write_text(yaml.safe_dump(s, default_flow_style=None, sort_keys=False))
+    out = workdir / f"{name}.h5"
+    cmd = [str(exe), "solve", str(scene_path), "-o", str(out), "--targets",
+           ",".join(f"{t:.17g}" for t in targets), "--repeat", str(passes)]
+    print("$ " + " ".join(cmd), flush=True)
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    sys.stdout.write(r.stdout)
+    if r.returncode != 0:
+        sys.stderr.write(r.stderr)
+        sys.exit(f"bench_dolfinx: hypershape failed (exit {r.returncode})")
+    return out
+
+
+def read_hypershape(path):
+    import h5py
+    import numpy as np
+    with h5py.File(path, "r") as f:
+        out = {k: f["timings"][k][:] for k in f["timings"]}
+        out["nodes"] = f["mesh/nodes"][:]
+        out["cells"] = f["mesh/cells"][:].astype(np.int64)
+        out["u_last"] = f["fields/displacement"][:]
+        out["n_vertices"] = int(f.attrs["n_vertices"])
+        out["degree"] = int(f.attrs["degree"])
+    return out
+
+
+# ----------------------------------------------------------------------------------------------
+# DOLFINx side
+
+
+class Diverged(Exception):
+    pass
+
+
+class DolfinxScene:
+    """The scene's discretisation in DOLFINx on hypershape's mesh."""
+
+    def __init__(self, scene, hs, factor="lu", rtol=1e-9, atol=1e-12, max_it=20):
+        import numpy as np
+        import ufl
+        from dolfinx import fem, mesh
+        from dolfinx.fem.petsc import NonlinearProblem
+        from dolfinx.nls.petsc import NewtonSolver
+        from mpi4py import MPI
+        from petsc4py import PETSc
+
+        eff = scene["effects"]
+        nh, dp, gt = eff["neo_hookean"], eff["dirichlet_patch"], eff["gaussian_traction"]
+        unknown = set(eff) - {"neo_hookean", "dirichlet_patch", "gaussian_traction"}
+        if unknown:
+            sys.exit(f"bench_dolfinx: effects {sorted(unknown)} are not reproduced here")
+        E, nu = float(nh["E"]), float(nh["nu"])
+        mu, lam = E / (2 * (1 + nu)), E * nu / ((1 + nu) * (1 - 2 * nu))
+        self.rtol, self.atol = rtol, atol
+        nodes, cells, nv, deg = hs["nodes"], hs["cells"], hs["n_vertices"], hs["degree"]
+        dim = nodes.shape[1]
+        self.dim, self.degree = dim, deg
+        cell = "triangle" if dim == 2 else "tetrahedron"
+        domain = ufl.Mesh(ufl.VectorElement("Lagrange", ufl.Cell(cell, geometric_dimension=dim), 1))
+        msh = mesh.create_mesh(MPI.COMM_WORLD, cells[:, : dim + 1].copy(), nodes[:nv].copy(), domain)
+        self.msh = msh
+        V = fem.VectorFunctionSpace(msh, ("Lagrange", deg))
+        self.V = V
+        tdim, fdim = msh.topology.dim, msh.topology.dim - 1
+
+        # Clamp: boundary facets whose vertices all lie within r (+ hypershape's 1e-9 max(1, r)).
+        c, r = np.array(dp["center"], float), float(dp["radius"])
+        tol = 1e-9 * max(1.0, r)
+        clamped = mesh.locate_entities_boundary(
+            msh, fdim, lambda X: np.sqrt(((X[:dim].T - c) ** 2).sum(axis=1)) <= r + tol)
+        msh.topology.create_connectivity(fdim, tdim)
+        boundary = mesh.exterior_facet_indices(msh.topology)
+        neumann = np.setdiff1d(boundary, clamped)
+        tags = mesh.meshtags(msh, fdim, np.concatenate([clamped, neumann]).astype(np.int32),
+                             np.concatenate([np.full(len(clamped), 2), np.full(len(neumann), 1)]).astype(np.int32))
+        order = np.argsort(tags.indices)
+        tags = mesh.meshtags(msh, fdim, tags.indices[order], tags.values[order])
+        zero = np.zeros(dim, dtype=PETSc.ScalarType)
+        dofs = fem.locate_dofs_topological(V, fdim, clamped)
+        self.bc = fem.dirichletbc(zero, dofs, V)
+        self.n_clamped_nodes = len(dofs)
+
+        qdeg, fqdeg = 2 * deg - 1, 2 * deg + 2  # hypershape's SpaceOptions defaults
+        dx = ufl.Measure("dx", domain=msh, metadata={"quadrature_degree": qdeg})
+        ds = ufl.Measure("ds", domain=msh, subdomain_data=tags, metadata={"quadrature_degree": fqdeg})
+        x = ufl.SpatialCoordinate(msh)
+        self.p_n = fem.Constant(msh, np.array(gt["center"], dtype=PETSc.ScalarType))
+        g = np.array(gt["direction"], float)
+        self.g = fem.Constant(msh, (g / np.linalg.norm(g)).astype(PETSc.ScalarType))
+        gamma = float(gt["gamma"])
+        phi = ufl.exp(-ufl.dot(x - self.p_n, x - self.p_n) / (2 * gamma ** 2))
+        self.phi_form = fem.form(phi * ds(1))
+        self.inv_norm = fem.Constant(msh, PETSc.ScalarType(1.0))  # 1 / I_N
+        self.alpha = fem.Constant(msh, PETSc.ScalarType(0.0))
+
+        self.u = fem.Function(V)
+        v, du = ufl.TestFunction(V), ufl.TrialFunction(V)
+        F = ufl.variable(ufl.Identity(dim) + ufl.grad(self.u))
+        J = ufl.det(F)
+        # The seed's energy (appendix A): W = mu/2 (tr F^T F - d - 2 ln J) + lambda/2 (ln J)^2,
+        # with d = dim: in 2D plane strain F_33 = 1 adds tr 1 - 1 = 0.
+        W = mu / 2 * (ufl.tr(F.T * F) - dim - 2 * ufl.ln(J)) + lam / 2 * ufl.ln(J) ** 2
+        t_unit = self.g * phi * self.inv_norm
+        energy = W * dx - self.alpha * ufl.dot(t_unit, self.u) * ds(1)
+        residual = ufl.derivative(energy, self.u, v)
+        jacobian = ufl.derivative(residual, self.u, du)
+        self.f_ext_form = fem.form(ufl.dot(t_unit, v) * ds(1))
+        self.f_ext = fem.petsc.create_vector(self.f_ext_form)
+
+        bc = self.bc
+        owner = self
+        self.newton_iterations = 0
+
+        class GuardedProblem(NonlinearProblem):
+            """Stops Newton on a residual that is not finite (an inverted element: ln J), and
+            counts the Jacobian assemblies (= Newton iterations = numeric factorisations)."""
+
+            def F(self, x, b):
+                super().F(x, b)
+                if not np.isfinite(b.norm()):
+                    raise Diverged("residual not finite (det F <= 0)")
+
+            def J(self, x, A):
+                owner.newton_iterations += 1
+                super().J(x, A)
+
+        problem = GuardedProblem(residual, self.u, bcs=[bc], J=jacobian)
+        newton = NewtonSolver(MPI.COMM_WORLD, problem)
+        newton.convergence_criterion = "residual"
+        newton.rtol = 0.0  # the test is absolute, set per alpha: ||R|| <= rtol ||alpha f_ext|| + atol
+        newton.max_it = max_it
+        newton.error_on_nonconvergence = False
+        newton.report = False
+        self.newton = newton
+        self._set_factor(newton.krylov_solver, factor)
+
+        # K(0), the same for every load case of the mesh (dead loads): factorised once here.
+        self.u.x.array[:] = 0.0
+        K0 = fem.petsc.assemble_matrix(fem.form(jacobian), bcs=[bc])
+        K0.assemble()
+        self.K0 = K0
+        self.ksp0 = PETSc.KSP().create(MPI.COMM_WORLD)
+        self.ksp0.setOperators(K0)
+        self._set_factor(self.ksp0, factor)
+        self.a0 = self.f_ext.duplicate()
+        self.backup = self.u.vector.duplicate()
+
+        self.n_free = V.dofmap.index_map.size_global * V.dofmap.index_map_bs - dim * self.n_clamped_nodes
+        self.newton_solves = 0
+        self.failed = 0
+
+    @staticmethod
+    def _set_factor(ksp, factor):
+        ksp.setType("preonly")
+        pc = ksp.getPC()
+        pc.setType(factor)
+        pc.setFactorSolverType("mumps")
+
+    def set_load_point(self, p_n, g):
+        """Moves the traction (per load case in a factory): I_N and f_ext are recomputed."""
+        import numpy as np
+        from dolfinx import fem
+        from petsc4py import PETSc
+        self.p_n.value[:] = p_n
+        self.g.value[:] = np.asarray(g, float) / np.linalg.norm(g)
+        self.inv_norm.value = 1.0
+        I_N = fem.assemble_scalar(self.phi_form)
+        self.inv_norm.value = 1.0 / I_N
+        with self.f_ext.localForm() as loc:
+            loc.set(0.0)
+        fem.petsc.assemble_vector(self.f_ext, self.f_ext_form)
+        self.f_ext.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        fem.petsc.set_bc(self.f_ext, [self.bc], scale=0.0)
+        self.f_ext_norm = self.f_ext.norm()
+        return I_N
+
+    def max_u(self, vec=None):
+        import numpy as np
+        arr = self.u.x.array if vec is None else vec.array
+        n_owned = self.V.dofmap.index_map.size_local
+        return float(np.sqrt((arr.reshape(-1, self.dim)[:n_owned] ** 2).sum(axis=1)).max())
+
+    def newton_at(self, alpha):
+        """One Newton solve at alpha from the current state; True if converged."""
+        self.alpha.value = alpha
+        self.newton.atol = self.rtol * abs(alpha) * self.f_ext_norm + self.atol
+        try:
+            _, ok = self.newton.solve(self.u)
+        except (Diverged, RuntimeError):
+            ok = False
+        self.newton_solves += 1
+        return ok
+
+    def solve_to(self, alpha_from, alpha_to, max_failures=12):
+        """Load continuation from the current (converged) state at alpha_from to alpha_to: the
+        full step first; a failed step is undone and halved, a success doubles the next."""
+        a, step = alpha_from, alpha_to - alpha_from
+        self.u.vector.copy(self.backup)
+        failures = 0
+        while a != alpha_to:
+            a_try = alpha_to if abs(step) >= abs(alpha_to - a) else a + step
+            if self.newton_at(a_try):
+                a = a_try
+                self.u.vector.copy(self.backup)
+                step *= 2
+            else:
+                self.backup.copy(self.u.vector)
+                self.u.x.scatter_forward()
+                step /= 2
+                failures += 1
+                self.failed += 1
+                if failures > max_failures:
+                    return False
+        return True
+
+    def reset(self):
+        self.u.x.array[:] = 0.0
+
+    def solve_for_target(self, target, target_rtol=1e-3, max_solves=30):
+        """The paper's way: proportional guess from the linear response, then a secant search
+        on alpha, each alpha solved from the last converged state. From rest."""
+        self.reset()
+        self.newton_iterations = self.newton_solves = self.failed = 0
+        self.ksp0.solve(self.f_ext, self.a0)
+        alpha = target / self.max_u(self.a0)
+        pts = [(0.0, 0.0)]
+        a_state = 0.0
+        for _ in range(max_solves):
+            if not self.solve_to(a_state, alpha):
+                return {"converged": False, "alpha": alpha, "max_displacement": self.max_u()}
+            a_state = alpha
+            m = self.max_u()
+            pts.append((alpha, m))
+            if abs(m / target - 1) <= target_rtol:
+                return {"converged": True, "alpha": alpha, "max_displacement": m}
+            (a0, m0), (a1, m1) = pts[-2], pts[-1]
+            alpha = a1 + (target - m1) * (a1 - a0) / (m1 - m0)
+        return {"converged": False, "alpha": alpha, "max_displacement": self.max_u()}
+
+    def node_values(self, nodes):
+        """u at hypershape's nodes (matched by coordinates), n_nodes x dim; NaN if unmatched."""
+        import numpy as np
+        xs = self.V.tabulate_dof_coordinates()[:, : self.dim]
+        vals = self.u.x.array.reshape(-1, self.dim)[: len(xs)]
+        key = lambda p: tuple(np.round(p, 9))  # noqa: E731
+        where = {key(p): i for i, p in enumerate(xs)}
+        out = np.full(nodes.shape, np.nan)
+        for i, p in enumerate(nodes):
+            j = where.get(key(p))
+            if j is not None:
+                out[i] = vals[j]
+        return out
+
+
+# ----------------------------------------------------------------------------------------------
+
+
+def median(v):
+    return statistics.median(v) if v else float("nan")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("scene", nargs="?", default=str(ROOT / "configs/scenes/disk_p2.yaml"),
+                    help="scene YAML (default: configs/scenes/disk_p2.yaml, the seed's disk)")
+    ap.add_argument("--case", action="append", metavar="DEGREE:H",
+                    help="element degree and mesh.h (repeatable; default 1:0.04 and 2:0.08)")
+    ap.add_argument("--targets", default="0.1,0.2,0.3,0.4,0.5",
+                    help="target max|u| of the load cases, solved in turn (default 0.1,...,0.5)")
+    ap.add_argument("--repeat", type=int, default=3,
+                    help="timed passes over the targets, after one warm-up pass (default 3)")
+    ap.add_argument("--hypershape", default=str(ROOT / "build/hypershape"), help="the binary to measure")
+    ap.add_argument("--factor", choices=["lu", "cholesky"], default="lu",
+                    help="DOLFINx's factorisation (MUMPS; default lu)")
+    ap.add_argument("--json", default=str(ROOT / "results/bench_dolfinx.json"))
+    ap.add_argument("--workdir", default=None, help="where the scenes and hypershape outputs go "
+                    "(default: results/bench_dolfinx/)")
+    args = ap.parse_args()
+    import_dolfinx()
+    import logging
+    logging.getLogger().setLevel(logging.WARNING)  # FFCx's JIT compiler logs every build at INFO
+    import numpy as np
+    import yaml
+    import dolfinx
+
+    exe = Path(args.hypershape).resolve()
+    if not os.access(exe, os.X_OK):
+        sys.exit(f"bench_dolfinx: {exe} is not an executable (build first: scripts/setup.sh)")
+    scene = yaml.safe_load(Path(args.scene).read_text())
+    targets = [float(t) for t in args.targets.split(",")]
+    cases = args.case or ["1:0.04", "2:0.08"]
+    workdir = Path(args.workdir) if args.workdir else ROOT / "results/bench_dolfinx"
+    workdir.mkdir(parents=True, exist_ok=True)
+    solver_block = scene.get("solver") or {}
+    rtol = float(solver_block.get("rtol", 1e-9))
+    target_rtol = float(solver_block.get("target_rtol", 1e-3))
+    n_targets, passes = len(targets), args.repeat + 1
+    report = {"scene": str(args.scene), "hypershape": str(exe), "targets": targets, "repeat": args.repeat,
+              "dolfinx_version": dolfinx.__version__, "dolfinx_factor": f"mumps {args.factor}",
+              "machine": f"{os.cpu_count()} cores (shared), 1 process per side, OMP/BLAS threads 1",
+              "cases": []}
+
+    for spec in cases:
+        deg_s, h_s = spec.split(":")
+        degree, h = int(deg_s), float(h_s)
+        name = f"{Path(args.scene).stem}_p{degree}_h{h:g}"
+        print(f"\n=== {name}: P{degree}, h {h:g}, targets {targets}, {args.repeat} timed passes", flush=True)
+        out = run_hypershape(exe, scene, degree, h, targets, passes, workdir, name)
+        hs = read_hypershape(out)
+
+        t0 = time.perf_counter()
+        dx = DolfinxScene(scene, hs, factor=args.factor, rtol=rtol)
+        g = scene["effects"]["gaussian_traction"]
+        I_N = dx.set_load_point(g["center"], g["direction"])
+        setup_s = time.perf_counter() - t0
+        n_hs = int(sum(1 for _ in hs["nodes"]))
+        print(f"DOLFINx set-up (mesh, space, forms incl. JIT, K(0) factorisation): {setup_s:.2f} s; "
+              f"{dx.n_free} free unknowns, {dx.n_clamped_nodes} clamped nodes, I_N {I_N:.6g}")
+
+        # 1. Agreement at the same alpha: DOLFINx at hypershape's alpha (untimed).
+        agree = []
+        for k, T in enumerate(targets):
+            a_hs, m_hs = float(hs["alpha"][k]), float(hs["max_displacement"][k])
+            dx.reset()
+            ok = dx.solve_to(0.0, a_hs)
+            m_dx = dx.max_u()
+            agree.append({"target": T, "alpha": a_hs, "max_u_hypershape": m_hs, "max_u_dolfinx": m_dx,
+                          "converged": ok, "rel_diff": m_dx / m_hs - 1})
+        # the last solve left u at the last target's alpha: compare the nodal field.
+        u_dx = dx.node_values(hs["nodes"])
+        matched = ~np.isnan(u_dx[:, 0])
+        field_diff = float(np.abs(u_dx[matched] - hs["u_last"][matched]).max() /
+                           np.sqrt((hs["u_last"] ** 2).sum(axis=1)).max())
+        clamped_hs = int((np.abs(hs["u_last"]).sum(axis=1) == 0).sum())
+        print("same alpha, max|u| DOLFINx / hypershape - 1: " +
+              ", ".join(f"{a['rel_diff']:+.1e}" for a in agree) +
+              f"; nodal u (last target): max |du| / max|u| {field_diff:.1e} over {matched.sum()}/{n_hs} "
+              f"matched nodes; nodes with u = 0: hypershape {clamped_hs}, DOLFINx clamped {dx.n_clamped_nodes}")
+
+        # 2. Timed: the same targets, the same passes (first = warm-up), secant search from rest.
+        dx_runs = []
+        for p in range(passes):
+            for T in targets:
+                t0 = time.perf_counter()
+                r = dx.solve_for_target(T, target_rtol=target_rtol)
+                r["seconds"] = time.perf_counter() - t0
+                r.update(target=T, newton_iterations=dx.newton_iterations, solves=dx.newton_solves,
+                         failed_increments=dx.failed)
+                dx_runs.append(r)
+        hs_runs = [{"target": float(hs["target"][i]), "alpha": float(hs["alpha"][i]),
+                    "max_displacement": float(hs["max_displacement"][i]), "seconds": float(hs["seconds"][i]),
+                    "newton_iterations": int(hs["newton_iterations"][i]), "converged": bool(hs["converged"][i])}
+                   for i in range(len(hs["seconds"]))]
+        warm_hs, warm_dx = hs_runs[n_targets:], dx_runs[n_targets:]
+        alpha_diff = [d["alpha"] / s["alpha"] - 1 for d, s in zip(warm_dx, warm_hs)]
+        umax_diff = [d["max_displacement"] / s["max_displacement"] - 1 for d, s in zip(warm_dx, warm_hs)]
+        med_hs = median([r["seconds"] for r in warm_hs])
+        med_dx = median([r["seconds"] for r in warm_dx])
+        case = {
+            "name": name, "degree": degree, "h": h, "vertices": hs["n_vertices"],
+            "cells": int(len(hs["cells"])), "nodes": n_hs, "unknowns": dx.n_free,
+            "hypershape_s_median": med_hs, "dolfinx_s_median": med_dx, "ratio": med_dx / med_hs,
+            "hypershape_newton_median": median([r["newton_iterations"] for r in warm_hs]),
+            "dolfinx_newton_median": median([r["newton_iterations"] for r in warm_dx]),
+            "dolfinx_solves_median": median([r["solves"] for r in warm_dx]),
+            "converged": {"hypershape": sum(r["converged"] for r in warm_hs),
+                          "dolfinx": sum(r["converged"] for r in warm_dx), "of": len(warm_hs)},
+            "alpha_rel_diff_max": float(np.max(np.abs(alpha_diff))),
+            "max_u_rel_diff_max": float(np.max(np.abs(umax_diff))),
+            "same_alpha": {"max_u_rel_diff_max": float(max(abs(a["rel_diff"]) for a in agree)),
+                           "field_rel_diff": field_diff, "per_target": agree},
+            "dolfinx_setup_s": setup_s,
+            "hypershape_runs": hs_runs, "dolfinx_runs": dx_runs,
+        }
+        report["cases"].append(case)
+        print(f"hypershape {med_hs:.3f} s/load case (median Newton its {case['hypershape_newton_median']:g}), "
+              f"DOLFINx {med_dx:.3f} s/load case (median Newton its {case['dolfinx_newton_median']:g}, "
+              f"solves {case['dolfinx_solves_median']:g}) -> {case['ratio']:.1f}x; "
+              f"alpha |rel diff| <= {case['alpha_rel_diff_max']:.1e}", flush=True)
+
+    rows = ["| case | unknowns | hypershape s/load case | DOLFINx s/load case | ratio | Newton its (hs / DOLFINx) "
+            "| alpha rel. diff (max) | max\\|u\\| rel. diff at the same alpha |",
+            "|---|---|---|---|---|---|---|---|"]
+    for c in report["cases"]:
+        rows.append(f"| {Path(args.scene).stem} P{c['degree']} h {c['h']:g} | {c['unknowns']} | "
+                    f"{c['hypershape_s_median']:.3f} | {c['dolfinx_s_median']:.3f} | {c['ratio']:.1f}x | "
+                    f"{c['hypershape_newton_median']:g} / {c['dolfinx_newton_median']:g} | "
+                    f"{c['alpha_rel_diff_max']:.1e} | {c['same_alpha']['max_u_rel_diff_max']:.1e} |")
+    table = "\n".join(rows)
+    report["table"] = table
+    Path(args.json).parent.mkdir(parents=True, exist_ok=True)
+    Path(args.json).write_text(json.dumps(report, indent=1))
+    print(f"\nmedians over {args.repeat} x {n_targets} warm load cases (targets {targets}), "
+          f"1 process each, {report['machine']}:\n{table}\n-> {args.json}")
+
+
+if __name__ == "__main__":
+    main()
