@@ -121,6 +121,76 @@ def read_hypershape(path):
 # DOLFINx side
 
 
+# hypershape's quadrature (src/physics/space.cpp): PETSc's minimal symmetric simplex rules
+# (PetscDTSimplexQuadrature(dim, degree, PETSCDTSIMPLEXQUAD_MINSYM)) of exactness 2 p - 1 on
+# cells and 2 p + 2 on facets, printed from PETSc 3.18 and mapped to Basix's reference simplex.
+# On intervals they are Gauss-Legendre, as Basix's default; on triangles and tetrahedra Basix's
+# default rules of the same degree have other points (on the disk at P2 h 0.08 that moved
+# max|u| by 5e-4), so the cell and the 3D facet integrals get these as custom rules.
+MINSYM = {  # (dim, degree): [(reference point (Basix's simplex), weight), ...]
+    (2, 1): [
+        ((0.33333333333333337, 0.33333333333333337), 0.5),
+    ],
+    (2, 3): [
+        ((0.4459484909159649, 0.4459484909159649), 0.11169079483900574),
+        ((0.09157621350977074, 0.09157621350977074), 0.054975871827660935),
+        ((0.4459484909159649, 0.10810301816807022), 0.11169079483900574),
+        ((0.09157621350977074, 0.8168475729804585), 0.054975871827660935),
+        ((0.10810301816807022, 0.4459484909159649), 0.11169079483900574),
+        ((0.8168475729804585, 0.09157621350977074), 0.054975871827660935),
+    ],
+    (2, 4): [
+        ((0.4459484909159649, 0.4459484909159649), 0.11169079483900574),
+        ((0.09157621350977074, 0.09157621350977074), 0.054975871827660935),
+        ((0.4459484909159649, 0.10810301816807022), 0.11169079483900574),
+        ((0.09157621350977074, 0.8168475729804585), 0.054975871827660935),
+        ((0.10810301816807022, 0.4459484909159649), 0.11169079483900574),
+        ((0.8168475729804585, 0.09157621350977074), 0.054975871827660935),
+    ],
+    (2, 6): [
+        ((0.06308901449150223, 0.06308901449150223), 0.02542245318510341),
+        ((0.24928674517091043, 0.24928674517091043), 0.058393137863189684),
+        ((0.06308901449150223, 0.8738219710169955), 0.02542245318510341),
+        ((0.24928674517091043, 0.5014265096581791), 0.058393137863189684),
+        ((0.8738219710169955, 0.06308901449150223), 0.02542245318510341),
+        ((0.5014265096581791, 0.24928674517091043), 0.058393137863189684),
+        ((0.05314504984481694, 0.6365024991213987), 0.041425537809186785),
+        ((0.05314504984481694, 0.3103524510337844), 0.041425537809186785),
+        ((0.6365024991213987, 0.05314504984481694), 0.041425537809186785),
+        ((0.3103524510337844, 0.05314504984481694), 0.041425537809186785),
+        ((0.3103524510337844, 0.6365024991213987), 0.041425537809186785),
+        ((0.6365024991213987, 0.3103524510337844), 0.041425537809186785),
+    ],
+    (3, 1): [
+        ((0.25, 0.25, 0.25), 0.16666666666666666),
+    ],
+    (3, 3): [
+        ((0.328681146665349, 0.328681146665349, 0.328681146665349), 0.02124855192625107),
+        ((0.1119207275092915, 0.1119207275092915, 0.1119207275092915), 0.020418114740415595),
+        ((0.328681146665349, 0.328681146665349, 0.013956560003953067), 0.02124855192625107),
+        ((0.1119207275092915, 0.1119207275092915, 0.6642378174721254), 0.020418114740415595),
+        ((0.328681146665349, 0.013956560003953067, 0.328681146665349), 0.02124855192625107),
+        ((0.1119207275092915, 0.6642378174721254, 0.1119207275092915), 0.020418114740415595),
+        ((0.013956560003953067, 0.328681146665349, 0.328681146665349), 0.02124855192625107),
+        ((0.6642378174721254, 0.1119207275092915, 0.1119207275092915), 0.020418114740415595),
+    ],
+}
+
+
+def quadrature(dim, degree):
+    """UFL measure metadata for hypershape's rule of `degree` on the `dim`-simplex."""
+    import numpy as np
+    rule = MINSYM.get((dim, degree))
+    if rule is None:
+        if dim > 1:
+            print(f"warning: no copy of PETSc's MINSYM rule for dim {dim} degree {degree}; "
+                  "using Basix's default rule of that degree")
+        return {"quadrature_degree": degree}
+    return {"quadrature_degree": degree, "quadrature_rule": "custom",
+            "quadrature_points": np.array([p for p, _ in rule]),
+            "quadrature_weights": np.array([w for _, w in rule])}
+
+
 class Diverged(Exception):
     pass
 
@@ -174,8 +244,8 @@ class DolfinxScene:
         self.n_clamped_nodes = len(dofs)
 
         qdeg, fqdeg = 2 * deg - 1, 2 * deg + 2  # hypershape's SpaceOptions defaults
-        dx = ufl.Measure("dx", domain=msh, metadata={"quadrature_degree": qdeg})
-        ds = ufl.Measure("ds", domain=msh, subdomain_data=tags, metadata={"quadrature_degree": fqdeg})
+        dx = ufl.Measure("dx", domain=msh, metadata=quadrature(dim, qdeg))
+        ds = ufl.Measure("ds", domain=msh, subdomain_data=tags, metadata=quadrature(dim - 1, fqdeg))
         x = ufl.SpatialCoordinate(msh)
         self.p_n = fem.Constant(msh, np.array(gt["center"], dtype=PETSc.ScalarType))
         g = np.array(gt["direction"], float)
