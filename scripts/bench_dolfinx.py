@@ -555,6 +555,10 @@ def main():
             "hypershape_newton_median": median([r["newton_iterations"] for r in warm_hs]),
             "dolfinx_newton_median": median([r["newton_iterations"] for r in warm_dx]),
             "dolfinx_solves_median": median([r["solves"] for r in warm_dx]),
+            "hypershape_ms_per_newton": 1e3 * sum(r["seconds"] for r in warm_hs) /
+            max(1, sum(r["newton_iterations"] for r in warm_hs)),
+            "dolfinx_ms_per_newton": 1e3 * sum(r["seconds"] for r in warm_dx) /
+            max(1, sum(r["newton_iterations"] for r in warm_dx)),
             "converged": {"hypershape": sum(r["converged"] for r in warm_hs),
                           "dolfinx": sum(r["converged"] for r in warm_dx), "of": len(warm_hs)},
             "alpha_rel_diff_max": float(np.max(np.abs(alpha_diff))),
@@ -571,12 +575,15 @@ def main():
               f"alpha |rel diff| <= {case['alpha_rel_diff_max']:.1e}", flush=True)
 
     rows = ["| case | unknowns | hypershape s/load case | DOLFINx s/load case | ratio | Newton its (hs / DOLFINx) "
+            "| ms per Newton it. (hs / DOLFINx) | converged (hs / DOLFINx) "
             "| alpha rel. diff (max) | max\\|u\\| rel. diff at the same alpha |",
-            "|---|---|---|---|---|---|---|---|"]
+            "|---|---|---|---|---|---|---|---|---|---|"]
     for c in report["cases"]:
         rows.append(f"| {Path(args.scene).stem} P{c['degree']} h {c['h']:g} | {c['unknowns']} | "
                     f"{c['hypershape_s_median']:.3f} | {c['dolfinx_s_median']:.3f} | {c['ratio']:.1f}x | "
                     f"{c['hypershape_newton_median']:g} / {c['dolfinx_newton_median']:g} | "
+                    f"{c['hypershape_ms_per_newton']:.0f} / {c['dolfinx_ms_per_newton']:.0f} | "
+                    f"{c['converged']['hypershape']}/{c['converged']['dolfinx']} of {c['converged']['of']} | "
                     f"{c['alpha_rel_diff_max']:.1e} | {c['same_alpha']['max_u_rel_diff_max']:.1e} |")
     table = "\n".join(rows)
     report["table"] = table
