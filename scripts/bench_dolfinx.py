@@ -154,6 +154,14 @@ def hypershape_side(exe, scene, degree, h, targets, passes, workdir, name, extra
     return hs
 
 
+def load_cases(hs):
+    """hypershape's load cases as a list of records."""
+    return [{"target": float(hs["target"][i]), "alpha": float(hs["alpha"][i]),
+             "max_displacement": float(hs["max_displacement"][i]), "seconds": float(hs["seconds"][i]),
+             "newton_iterations": int(hs["newton_iterations"][i]), "converged": bool(hs["converged"][i])}
+            for i in range(len(hs["seconds"]))]
+
+
 # ----------------------------------------------------------------------------------------------
 # DOLFINx side
 
@@ -529,7 +537,7 @@ def main():
         g = scene["effects"]["gaussian_traction"]
         I_N = dx.set_load_point(g["center"], g["direction"])
         setup_s = time.perf_counter() - t0
-        n_hs = int(sum(1 for _ in hs["nodes"]))
+        n_hs = len(hs["nodes"])
         print(f"DOLFINx set-up (mesh, space, forms incl. JIT, K(0) factorisation): {setup_s:.2f} s; "
               f"{dx.n_free} free unknowns, {dx.n_clamped_nodes} clamped nodes, I_N {I_N:.6g}")
 
@@ -556,21 +564,14 @@ def main():
         # 2. Timed: the same targets, the same passes (first = warm-up), secant search from rest;
         # the two sides take turns `rounds` times (hypershape's first round is the run above),
         # so that a shift in the host's load falls on both.
-        def hypershape_runs(hs):
-            return [{"target": float(hs["target"][i]), "alpha": float(hs["alpha"][i]),
-                     "max_displacement": float(hs["max_displacement"][i]), "seconds": float(hs["seconds"][i]),
-                     "newton_iterations": int(hs["newton_iterations"][i]), "converged": bool(hs["converged"][i])}
-                    for i in range(len(hs["seconds"]))]
-
         warm_hs, warm_dx, dx_runs, hs_runs = [], [], [], []
+        nodes0 = hs["nodes"]
         for rnd in range(args.rounds):
             if rnd > 0:
                 hs = hypershape_side(exe, scene, degree, h, targets, passes, workdir, name, hs_extra, multi)
                 if hs["nodes"].shape != nodes0.shape or not np.array_equal(hs["nodes"], nodes0):
                     sys.exit("bench_dolfinx: hypershape meshed the scene differently in another run")
-            else:
-                nodes0 = hs["nodes"]
-            runs = hypershape_runs(hs)
+            runs = load_cases(hs)
             hs_runs += runs
             warm_hs += runs[n_targets:]
             runs = []
