@@ -1,6 +1,7 @@
 /// hypershape: the command-line entry point.
 ///
-///   hypershape solve [SCENE.yaml] -o OUT.h5     one scene (default: the embedded one)
+///   hypershape solve [SCENE.yaml] -o OUT.h5     one scene (default: the embedded one);
+///                                               --targets/--repeat: several load cases (benchmarks)
 ///   hypershape shapes CONFIG.yaml -o SHAPES.h5  random shapes of a dataset config (meshes,
 ///                                               Dirichlet patches, metrics); MPI-parallel
 ///   hypershape generate [DATASET.yaml] [-o DIR]  a dataset (default: the embedded small one);
@@ -58,6 +59,14 @@ int run(int argc, char** argv) {
   std::string scene_path, out = "solution.h5";
   solve->add_option("scene", scene_path, "scene file (YAML); default: the embedded default scene");
   solve->add_option("-o,--output", out, "output file (.h5); an .xdmf file is written beside it");
+  factory::SceneRuns runs;
+  solve->add_option("--targets", runs.targets,
+                    "benchmarks: solve these targets (max|u|) in turn instead of load.target, each "
+                    "from rest on the same solver; each one's seconds, alpha, ... in /timings/")
+      ->delimiter(',')
+      ->check(CLI::Range(1e-12, 2.0));
+  solve->add_option("--repeat", runs.repeat, "benchmarks: solve the load case(s) N times")
+      ->check(CLI::PositiveNumber);
   solve->allow_extras();
   auto* shapes = app.add_subcommand("shapes", "draw and mesh the random shapes of a dataset config");
   std::string shapes_config, shapes_out = "shapes.h5";
@@ -155,7 +164,7 @@ int run(int argc, char** argv) {
   config::Scene scene = scene_path.empty()
                             ? config::parse_scene_text(config::default_scene_text(), "<default scene>")
                             : config::parse_scene_file(scene_path);
-  auto outcome = factory::solve_scene(comm, scene);
+  auto outcome = factory::solve_scene(comm, scene, runs);
   auto t0 = core::now_seconds();
   if (rank == 0) io::write_solution(out, outcome.record);
   outcome.times.add("write", core::now_seconds() - t0);

@@ -32,7 +32,7 @@ std::optional<mesh::ClampRegion> clamp_of(const config::Scene& s) {
 
 }  // namespace
 
-SceneOutcome solve_scene(MPI_Comm comm, const config::Scene& scene_in) {
+SceneOutcome solve_scene(MPI_Comm comm, const config::Scene& scene_in, const SceneRuns& runs) {
   SceneOutcome o;
   config::Scene scene = scene_in;
   mesh::MeshData m;
@@ -84,23 +84,35 @@ SceneOutcome solve_scene(MPI_Comm comm, const config::Scene& scene_in) {
   }
   {
     auto t = o.times.scope("solve");
-    if (scene.target) {
-      auto r = nl->solve_for_target(*scene.target);
-      o.converged = r.converged;
-      o.reason = r.reason;
-      o.alpha = r.alpha;
-      o.newton_iterations = r.newton_iterations;
-      o.solves = r.solves;
-      o.failed_increments = r.failed_increments;
-    } else {
-      auto r = nl->solve(*scene.alpha);
-      o.converged = r.converged;
-      o.reason = r.reason;
-      o.alpha = r.load_factor;
-      o.newton_iterations = r.newton_iterations;
-      o.solves = 1;
-      o.failed_increments = r.failed_increments;
-    }
+    std::vector<std::optional<double>> targets;
+    for (double v : runs.targets) targets.emplace_back(v);
+    if (targets.empty()) targets.push_back(scene.target);
+    for (int rep = 0; rep < std::max(runs.repeat, 1); ++rep)
+      for (const auto& target : targets) {
+        if (!o.load_cases.empty()) nl->reset();
+        const double t0 = core::now_seconds();
+        if (target) {
+          auto r = nl->solve_for_target(*target);
+          o.converged = r.converged;
+          o.reason = r.reason;
+          o.alpha = r.alpha;
+          o.newton_iterations = r.newton_iterations;
+          o.solves = r.solves;
+          o.failed_increments = r.failed_increments;
+        } else {
+          auto r = nl->solve(*scene.alpha);
+          o.converged = r.converged;
+          o.reason = r.reason;
+          o.alpha = r.load_factor;
+          o.newton_iterations = r.newton_iterations;
+          o.solves = 1;
+          o.failed_increments = r.failed_increments;
+        }
+        const double seconds = core::now_seconds() - t0;
+        o.load_cases.push_back({target.value_or(0.0), o.alpha, problem->max_displacement(nl->solution()),
+                                seconds, o.newton_iterations, o.converged});
+      }
+    if (targets.back()) scene.target = targets.back();
     o.max_displacement = problem->max_displacement(nl->solution());
     o.min_det_f = problem->min_det_f(nl->solution());
   }
@@ -129,6 +141,18 @@ SceneOutcome solve_scene(MPI_Comm comm, const config::Scene& scene_in) {
                    {"newton_iterations", double(o.newton_iterations)}};
       if (scene.target) r.numbers["target"] = *scene.target;
       r.strings = {{"reason", o.reason}, {"source", scene.source}};
+      if (o.load_cases.size() > 1) {
+        auto column = [&](const char* name, auto get) {
+          auto& v = r.timings[name];
+          for (const auto& c : o.load_cases) v.push_back(double(get(c)));
+        };
+        column("target", [](const auto& c) { return c.target; });
+        column("alpha", [](const auto& c) { return c.alpha; });
+        column("max_displacement", [](const auto& c) { return c.max_displacement; });
+        column("converged", [](const auto& c) { return c.converged; });
+        column("newton_iterations", [](const auto& c) { return c.newton_iterations; });
+      }
+      for (const auto& c : o.load_cases) r.timings["seconds"].push_back(c.seconds);
     }
   }
   return o;
@@ -137,6 +161,10 @@ SceneOutcome solve_scene(MPI_Comm comm, const config::Scene& scene_in) {
 std::string summary_line(const SceneOutcome& o) {
   std::string times;
   for (auto& [k, v] : o.times.all()) times += fmt::format(" {} {:.3f}s", k, v);
+  if (o.load_cases.size() > 1) {
+    times += " | load case s:";
+    for (const auto& c : o.load_cases) times += fmt::format(" {:.4f}", c.seconds);
+  }
   return fmt::format("{}D P{}: {} vertices, {} cells, {} dofs | {} | alpha {:.6g}, max|u| {:.6g}, min det F {:.3f} | "
                      "{} Newton iterations in {} solves ({} failed increments) |{}",
                      o.dim, o.degree, o.n_vertices, o.n_cells, o.n_dofs,

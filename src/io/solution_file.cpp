@@ -65,6 +65,12 @@ void write_solution(const std::string& path, const SolutionRecord& r) {
         for (int c = 0; c < r.dim; ++c) u3[i * 3 + c] = r.displacement[i * r.dim + c];
       write_2d(xdmf.id, "displacement3", H5T_NATIVE_DOUBLE, u3.data(), n_nodes, 3);
       write_string_dataset(inputs.id, "scene", r.scene_text);
+      if (!r.timings.empty()) {
+        Id timings{check_id(H5Gcreate2(file.id, "timings", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), "timings"),
+                   H5Gclose};
+        for (const auto& [name, v] : r.timings)
+          write_1d(timings.id, name.c_str(), H5T_NATIVE_DOUBLE, v.data(), v.size());
+      }
       attr_double(file.id, "dim", r.dim);
       attr_double(file.id, "degree", r.degree);
       attr_double(file.id, "n_vertices", double(r.n_vertices));

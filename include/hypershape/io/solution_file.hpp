@@ -7,6 +7,8 @@
 ///   /mesh/cells            n_cells x k      VTK-ordered node indices (k = 3, 6, 4 or 10)
 ///   /fields/displacement   n_nodes x dim    u at the nodes
 ///   /inputs/scene          string           the scene file as read
+///   /timings/seconds       n_solves         seconds of each solve (target, alpha, ... with
+///                                           several: `hypershape solve --repeat/--targets`)
 ///   attributes on /: dim, degree, n_vertices, alpha, target, max_displacement, converged,
 ///                    reason, newton_iterations, hypershape_version
 #include <cstdint>
@@ -25,6 +27,7 @@ struct SolutionRecord {
   std::string scene_text;
   std::map<std::string, double> numbers;       ///< scalar attributes
   std::map<std::string, std::string> strings;  ///< string attributes
+  std::map<std::string, std::vector<double>> timings;  ///< /timings/<name>, one entry per solve
 };
 
 /// Writes `path` (.h5) and `path` with .xdmf. Not collective: call on one rank. Throws
