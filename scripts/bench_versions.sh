@@ -4,8 +4,10 @@
 # (counted by PETSc's own log: MatCholFctrNum, KSPGMRESOrthog), the converged share, and how
 # far the two datasets' displacements are apart on the load cases both converged.
 #   scripts/bench_versions.sh OTHER_HYPERSHAPE [SHAPES] [LOADS] [REPEATS]
+#   SHAPES_H=0.12 MESH='{degree: 2}' scripts/bench_versions.sh /tmp/old/hypershape 8 25 1
 #   PRESET=random3d MESH='{degree: 2, h: 0.3}' scripts/bench_versions.sh /tmp/old/hypershape 4 25 1
-# Environment: PRESET (default random2d), MESH (a mesh: override, default the preset's),
+# Environment: PRESET (default random2d), SHAPES_H (shapes.h: the 2D mesh size), MESH (a mesh:
+# override, e.g. '{degree: 2}'; mesh.h is the 3D solve mesh size),
 # SOLVER (a solver: override for this build only, e.g. '{factor_reuse: false}').
 # JSON: results/bench_versions.json. Build the other version with e.g.
 #   git worktree add /tmp/old HEAD~1 && (cd /tmp/old && scripts/setup.sh)
@@ -20,7 +22,7 @@ slice() {  # $1: file, $2: extra solver block
   {
     echo "preset: ${PRESET:-random2d}"
     echo "name: bench_versions"
-    echo "shapes: {count: $shapes}"
+    echo "shapes: {count: $shapes${SHAPES_H:+, h: $SHAPES_H}}"
     echo "loads: {count: $loads}"
     echo "output: {shard_size: 4}"
     if [ -n "${MESH:-}" ]; then echo "mesh: $MESH"; fi

@@ -81,6 +81,21 @@ void configure_direct_solver(KSP ksp, MPI_Comm comm, int dim) {
   }
 }
 
+core::KSPH make_factor_preconditioned_gmres(MPI_Comm comm, void* ctx, PetscErrorCode (*apply)(PC, Vec, Vec),
+                                            const char* name) {
+  core::KSPH ksp;
+  HS_PETSC(KSPCreate(comm, ksp.out()));
+  HS_PETSC(KSPSetType(ksp, KSPGMRES));
+  HS_PETSC(KSPSetPCSide(ksp, PC_RIGHT));
+  PC pc;
+  HS_PETSC(KSPGetPC(ksp, &pc));
+  HS_PETSC(PCSetType(pc, PCSHELL));
+  HS_PETSC(PCShellSetContext(pc, ctx));
+  HS_PETSC(PCShellSetApply(pc, apply));
+  HS_PETSC(PCShellSetName(pc, name));
+  return ksp;
+}
+
 LdltFactor::LdltFactor(const physics::Problem& problem, const std::string& prefix) {
   HS_PETSC(KSPCreate(problem.comm(), ksp_.out()));
   if (!prefix.empty()) HS_PETSC(KSPSetOptionsPrefix(ksp_, prefix.c_str()));
@@ -99,7 +114,6 @@ LdltFactor::LdltFactor(const physics::Problem& problem, const std::string& prefi
   } else {
     HS_PETSC(KSPSetFromOptions(ksp_));
   }
-  F_ = problem.create_matrix();
 }
 
 void LdltFactor::set_up_blocked(Mat A) {
@@ -193,6 +207,11 @@ void LdltFactor::scatter_values(Mat A) {
 bool LdltFactor::factorise(Mat A) {
   if (!analysed_ && blocked_) set_up_blocked(A);
   analysed_ = true;
+  if (!blocked_ && !F_) {
+    HS_PETSC(MatDuplicate(A, MAT_DO_NOT_COPY_VALUES, F_.out()));
+    HS_PETSC(MatSetOption(F_, MAT_SYMMETRIC, PETSC_TRUE));
+    HS_PETSC(MatSetOption(F_, MAT_SYMMETRY_ETERNAL, PETSC_TRUE));
+  }
   if (blocked_) scatter_values(A);
   else HS_PETSC(MatCopy(A, F_, SAME_NONZERO_PATTERN));
   // PCSetUp factorises now (not at the first solve), so that a failure is seen here.
@@ -254,14 +273,7 @@ void LdltFactor::refine() {
   constexpr double rtol = 1e-10;
   if (!(rn > rtol * bn)) return;
   if (!refine_) {
-    HS_PETSC(KSPCreate(PETSC_COMM_SELF, refine_.out()));
-    HS_PETSC(KSPSetType(refine_, KSPGMRES));
-    HS_PETSC(KSPSetPCSide(refine_, PC_RIGHT));
-    PC pc;
-    HS_PETSC(KSPGetPC(refine_, &pc));
-    HS_PETSC(PCSetType(pc, PCSHELL));
-    HS_PETSC(PCShellSetContext(pc, this));
-    HS_PETSC(PCShellSetApply(pc, apply_factor));
+    refine_ = make_factor_preconditioned_gmres(PETSC_COMM_SELF, this, apply_factor, "LDL^T factor (refinement)");
     HS_PETSC(KSPSetInitialGuessNonzero(refine_, PETSC_TRUE));
   }
   HS_PETSC(KSPSetOperators(refine_, F_, F_));

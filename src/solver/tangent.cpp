@@ -40,18 +40,9 @@ Tangent::Tangent(const physics::Problem& problem, const TangentOptions& opt, con
   forcing_ = opt_.krylov_rtol;
   J_ = problem.create_matrix();
   work_ = std::make_unique<LdltFactor>(problem, prefix);
-  HS_PETSC(KSPCreate(problem.comm(), krylov_.out()));
+  krylov_ = make_factor_preconditioned_gmres(problem.comm(), this, apply_shell, "kept LDL^T factor of an earlier tangent");
   HS_PETSC(KSPSetOptionsPrefix(krylov_, (prefix + "tangent_").c_str()));
-  HS_PETSC(KSPSetType(krylov_, KSPGMRES));
   HS_PETSC(KSPGMRESSetRestart(krylov_, 40));
-  // Right preconditioning: the convergence test sees the true residual of K x = b.
-  HS_PETSC(KSPSetPCSide(krylov_, PC_RIGHT));
-  PC pc;
-  HS_PETSC(KSPGetPC(krylov_, &pc));
-  HS_PETSC(PCSetType(pc, PCSHELL));
-  HS_PETSC(PCShellSetContext(pc, this));
-  HS_PETSC(PCShellSetApply(pc, apply_shell));
-  HS_PETSC(PCShellSetName(pc, "kept LDL^T factor of an earlier tangent"));
   HS_PETSC(KSPSetOperators(krylov_, J_, J_));
   HS_PETSC(KSPSetFromOptions(krylov_));
 }

@@ -92,6 +92,7 @@ class Problem {
   std::unique_ptr<Space> space_;
   core::VecH load_;
   double load_norm_ = 0;
+  mutable core::MatH pattern_;  ///< the tangent's pattern, from the DM once (create_matrix)
 };
 
 }  // namespace hypershape::physics

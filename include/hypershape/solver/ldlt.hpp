@@ -33,6 +33,11 @@ int negative_eigenvalues(KSP ksp);
 /// with the KSP's prefix still apply when the caller calls KSPSetFromOptions).
 void configure_direct_solver(KSP ksp, MPI_Comm comm, int dim);
 
+/// A GMRES KSP on `comm`, right-preconditioned (its test sees the true residual) by a shell PC
+/// that calls `apply(pc, x, y)` with `ctx`: a kept factor as the preconditioner. Collective.
+core::KSPH make_factor_preconditioned_gmres(MPI_Comm comm, void* ctx, PetscErrorCode (*apply)(PC, Vec, Vec),
+                                            const char* name);
+
 class LdltFactor {
  public:
   /// Collective. `prefix`: options prefix of the factor's KSP.
