@@ -8,6 +8,7 @@
 #include <numeric>
 
 #include "hypershape/core/error.hpp"
+#include "hypershape/factory/dataset_schema.hpp"
 #include "hypershape/factory/load_cases.hpp"
 #include "hypershape/factory/shape_pipeline.hpp"
 #include "hypershape/factory/shape_set.hpp"
@@ -41,8 +42,7 @@ class Moments {
   }
   void store(std::vector<io::Array>& out) const {
     for (const auto& [name, m] : rows_)
-      out.push_back({"stats/" + name, {m.size() / 3, 3}, m,
-                     "per component: count, sum, sum of squares over this shape's converged values", ""});
+      out.push_back(schema_array("stats/" + name, {m.size() / 3, 3}, m));
   }
 
  private:
@@ -95,20 +95,6 @@ bool all_finite(const std::vector<double>& v) {
   return true;
 }
 
-/// Meaning and units of a channel's arrays (the schema of "loads/<channel>" and
-/// "loads/grid_<channel>"). Several tractions are summed (docs/FORMAT.md).
-std::pair<std::string, std::string> channel_doc(const std::string& name, bool grid) {
-  if (name == "traction")
-    return {grid ? "traction field alpha g phi(x - p_N) / I_N on the whole grid"
-                 : "traction t = alpha g phi / I_N at the Neumann nodes, zero elsewhere",
-            "force/length^(d-1)"};
-  if (name == "body_force")
-    return {grid ? "body force per unit reference volume on the whole grid (times alpha if scaled)"
-                 : "body force per unit reference volume at the nodes (times alpha if scaled)",
-            "force/length^d"};
-  return {name + (grid ? " on the grid" : " at the nodes"), ""};
-}
-
 /// The input channels the scene's effects bring (traction, body force, ...), per load case at
 /// the nodes ("loads/<name>", surface channels at the Neumann nodes only) and on the grid
 /// ("loads/grid_<name>"), each summed over its effects, a scaled effect times alpha. A channel
@@ -152,15 +138,13 @@ class Channels {
              const std::vector<std::uint64_t>& grid_shape, std::uint64_t d) {
     for (auto& c : channels_) {
       if (rep_.point_cloud) {
-        auto [meaning, units] = channel_doc(c.name, false);
-        arrays.push_back({"loads/" + c.name, {n_loads, n_nodes, d}, std::move(c.nodes), meaning, units});
+        arrays.push_back(schema_array("loads/" + c.name, {n_loads, n_nodes, d}, std::move(c.nodes)));
       }
       if (rep_.grid) {
         std::vector<std::uint64_t> s{n_loads};
         s.insert(s.end(), grid_shape.begin(), grid_shape.end());
         s.push_back(d);
-        auto [meaning, units] = channel_doc(c.name, true);
-        arrays.push_back({"loads/grid_" + c.name, s, std::move(c.grid), meaning, units});
+        arrays.push_back(schema_array("loads/grid_" + c.name, s, std::move(c.grid)));
       }
     }
   }
@@ -210,14 +194,13 @@ class DrawnParams {
     }
   }
   void store(std::vector<io::Array>& arrays) {
-    for (auto& [name, v] : values_)
-      arrays.push_back({"params/" + name, {std::uint64_t(v.size())}, std::move(v),
-                        v.size() == 1 ? "drawn once per shape" : "drawn per load case", ""});
+    for (auto& [name, v] : values_) {
+      const auto n = std::uint64_t(v.size());  // before v is moved
+      arrays.push_back(schema_array("params/" + name, {n}, std::move(v)));
+    }
     for (auto& [name, v] : placements_)
-      arrays.push_back({"params/" + name, {std::uint64_t(n_loads_), std::uint64_t(cfg_.shapes.dim)}, std::move(v),
-                        name.find("center") != std::string::npos ? "traction centre (on the Neumann boundary)"
-                                                                 : "traction direction (unit vector)",
-                        name.find("center") != std::string::npos ? "length" : ""});
+      arrays.push_back(
+          schema_array("params/" + name, {std::uint64_t(n_loads_), std::uint64_t(cfg_.shapes.dim)}, std::move(v)));
   }
 
  private:
@@ -301,14 +284,12 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
     cells = space.canonical_cells();
     n_nodes = std::int64_t(nodes.size()) / d;
     const auto per_cell = std::uint64_t(cells.size()) / std::uint64_t(shape.mesh.n_cells());
-    arrays.push_back({"nodes", {U64(n_nodes), U64(d)}, nodes,
-                      "finite-element nodes: mesh vertices first, then (P2) edge midpoints", "length"});
-    arrays.push_back({"cells", {U64(shape.mesh.n_cells()), per_cell}, cells,
-                      "cell-to-node connectivity, VTK order", ""});
+    arrays.push_back(schema_array("nodes", {U64(n_nodes), U64(d)}, nodes));
+    arrays.push_back(schema_array("cells", {U64(shape.mesh.n_cells()), per_cell}, cells));
     boundary_node_masks(shape.boundary, shape.dirichlet_facets, cells, cfg.degree, n_nodes, dirichlet_mask,
                         neumann_mask);
-    arrays.push_back({"dirichlet_mask", {U64(n_nodes)}, dirichlet_mask, "1 on the Dirichlet patch (u = 0)", ""});
-    arrays.push_back({"neumann_mask", {U64(n_nodes)}, neumann_mask, "1 on the Neumann boundary (traction)", ""});
+    arrays.push_back(schema_array("dirichlet_mask", {U64(n_nodes)}, dirichlet_mask));
+    arrays.push_back(schema_array("neumann_mask", {U64(n_nodes)}, neumann_mask));
     const geometry::SignedDistance sdf(shape.boundary);
     std::vector<std::int64_t> dfacets(shape.dirichlet_facets.begin(), shape.dirichlet_facets.end());
     const geometry::FacetSetDistance ddist(shape.boundary, dfacets);
@@ -318,10 +299,8 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
       ddist.evaluate(nodes, dd);
       moments.add("sdf", s.data(), s.size(), 1);
       moments.add("dirichlet_distance", dd.data(), dd.size(), 1);
-      arrays.push_back({"point_cloud/sdf", {U64(n_nodes)}, std::move(s),
-                        "signed distance to the boundary at the nodes (negative inside)", "length"});
-      arrays.push_back({"point_cloud/dirichlet_distance", {U64(n_nodes)}, std::move(dd),
-                        "distance to the Dirichlet patch at the nodes", "length"});
+      arrays.push_back(schema_array("point_cloud/sdf", {U64(n_nodes)}, std::move(s)));
+      arrays.push_back(schema_array("point_cloud/dirichlet_distance", {U64(n_nodes)}, std::move(dd)));
     }
     if (cfg.representations.grid) {
       grid = sampling::grid_points(d, N);
@@ -332,16 +311,11 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
       ddist.evaluate(grid, dd);
       moments.add("grid_sdf", s.data(), s.size(), 1);
       moments.add("grid_dirichlet_distance", dd.data(), dd.size(), 1);
-      arrays.push_back({"grid/sdf", grid_shape, to_float(s),
-                        "signed distance on the grid over [-1, 1]^d (negative inside), numpy 'ij' order",
-                        "length"});
-      arrays.push_back({"grid/dirichlet_distance", grid_shape, to_float(dd),
-                        "distance to the Dirichlet patch on the grid (0 on the patch, never negative)",
-                        "length"});
+      arrays.push_back(schema_array("grid/sdf", grid_shape, to_float(s)));
+      arrays.push_back(schema_array("grid/dirichlet_distance", grid_shape, to_float(dd)));
       sampler = std::make_unique<sampling::MeshSampler>(d, cfg.degree, nodes, cells, shape.boundary, sdf, grid);
       const auto inside = sampler->inside();
-      arrays.push_back({"grid/inside", grid_shape, std::vector<std::int8_t>(inside.begin(), inside.end()),
-                        "1 where the grid point is in the body", ""});
+      arrays.push_back(schema_array("grid/inside", grid_shape, std::vector<std::int8_t>(inside.begin(), inside.end())));
     }
   }
 
@@ -435,31 +409,27 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
     auto t = out.times.scope("representations");
     const U64 nl_ = U64(n_loads), du = U64(d);
     const bool has_traction = n_tractions(cfg) > 0;
-    arrays.push_back({"loads/status", {nl_}, status, "1 converged (target reached), 0 failed (see loads/reason)", ""});
-    arrays.push_back({"loads/alpha", {nl_}, alpha, "traction scale alpha = the total applied force |int t dS| (0 if failed)", "force"});
-    arrays.push_back({"loads/target", {nl_}, target, "wanted max|u|", "length"});
-    arrays.push_back({"loads/max_displacement", {nl_}, max_u, "achieved max over the nodes of |u| (0 if failed)", "length"});
-    arrays.push_back({"loads/min_det_f", {nl_}, min_det, "min det F over the quadrature points (0 if failed)", ""});
+    arrays.push_back(schema_array("loads/status", {nl_}, status));
+    arrays.push_back(schema_array("loads/alpha", {nl_}, alpha));
+    arrays.push_back(schema_array("loads/target", {nl_}, target));
+    arrays.push_back(schema_array("loads/max_displacement", {nl_}, max_u));
+    arrays.push_back(schema_array("loads/min_det_f", {nl_}, min_det));
     if (has_traction)
-      arrays.push_back({"loads/traction_normaliser", {nl_}, normaliser, "I_N = int_{Gamma_N} phi dS", "length^(d-1)"});
-    arrays.push_back({"loads/newton_iterations", {nl_}, newton, "Newton iterations, all solves of the alpha search", ""});
-    arrays.push_back({"loads/solves", {nl_}, solves, "nonlinear solves (alpha evaluations)", ""});
-    arrays.push_back({"loads/failed_increments", {nl_}, failed_inc, "load increments that failed and were halved", ""});
-    arrays.push_back({"loads/recovery_iterations", {nl_}, recovery,
-                      "Newton iterations spent in failed (discarded) increments: the cost of recovery", ""});
+      arrays.push_back(schema_array("loads/traction_normaliser", {nl_}, normaliser));
+    arrays.push_back(schema_array("loads/newton_iterations", {nl_}, newton));
+    arrays.push_back(schema_array("loads/solves", {nl_}, solves));
+    arrays.push_back(schema_array("loads/failed_increments", {nl_}, failed_inc));
+    arrays.push_back(schema_array("loads/recovery_iterations", {nl_}, recovery));
     if (has_traction) {
-      arrays.push_back({"loads/p_n", {nl_, du}, p_n, "traction centre p_N (on the Neumann boundary)", "length"});
-      arrays.push_back({"loads/g", {nl_, du}, g, "traction direction g (unit vector)", ""});
+      arrays.push_back(schema_array("loads/p_n", {nl_, du}, p_n));
+      arrays.push_back(schema_array("loads/g", {nl_, du}, g));
     }
-    arrays.push_back({"loads/displacement", {nl_, U64(n_nodes), du}, std::move(displacement),
-                      "displacement u at the nodes (zero if failed)", "length"});
+    arrays.push_back(schema_array("loads/displacement", {nl_, U64(n_nodes), du}, std::move(displacement)));
     if (cfg.representations.grid) {
       std::vector<U64> s{nl_};
       s.insert(s.end(), grid_shape.begin(), grid_shape.end());
       s.push_back(du);
-      arrays.push_back({"loads/grid_displacement", s, std::move(grid_u),
-                        "displacement on the grid: FE interpolant inside, closest-boundary-point value outside",
-                        "length"});
+      arrays.push_back(schema_array("loads/grid_displacement", s, std::move(grid_u)));
     }
     channels.store(arrays, nl_, U64(n_nodes), grid_shape, du);
     drawn.store(arrays);
