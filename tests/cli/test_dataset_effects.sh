@@ -8,6 +8,7 @@
 #    traction and body_force at the nodes and on the grid; the torch Datasets serve them;
 #  - `hypershape solve` on the same scene (the shape's mesh written as a .msh, the drawn
 #    values fixed) gives the same solution as `generate`;
+#  - a scene without a traction stores no traction, p_N, g or I_N (only the effects called for);
 #  - bad scenes stop before any work: exit code 2, the key path named, nothing written.
 # Needs HYPERSHAPE_BIN and HYPERSHAPE_SOURCE_DIR (set by CTest).
 . "$(dirname "$0")/lib.sh"
@@ -54,6 +55,21 @@ assert g.x_channels == ["sdf", "dirichlet_distance", "traction_x", "traction_y",
 assert g[0]["x"].shape == (6, 16, 16)
 pc = ht.PointCloudDataset(sys.argv[1], "train")
 assert pc[0]["x"].shape[1] == 6
+PY
+
+# ---- only the effects called for: no traction, a body force tuned by alpha -------------------
+printf 'preset: random2d\nname: gravity_only\nseed: 5\nshapes: {count: 1, h: 0.1}\nloads: {count: 2}\nrepresentations: {grid_size: 8}\neffects:\n  neo_hookean: {E: 500, nu: 0.49}\n  dirichlet_patch: {radius: 0.5}\n  body_force: {value: [0.0, -1.0]}\n' > "$work/gravity.yaml"
+"$bin" -q generate "$work/gravity.yaml" --progress 0 -o "$work/gravity" || fail "gravity-only run"
+/usr/bin/python3 - "$work/gravity" <<'PY' && ok "no traction in the scene: no traction, p_N, g or I_N stored; body_force scaled by alpha" || fail "gravity only"
+import sys, h5py, numpy as np
+import hypershape_data as hd, hypershape_torch as ht
+g = h5py.File(f"{sys.argv[1]}/shards/shard-000000.h5")["shapes/000000/loads"]
+assert not any(k in g for k in ("traction", "grid_traction", "p_n", "g", "traction_normaliser")), list(g)
+assert list(g["status"][:]) == [1, 1], g["reason"][:]
+b, alpha = g["body_force"][...], g["alpha"][...]
+assert np.allclose(b[:, :, 1], -alpha[:, None]) and np.all(b[:, :, 0] == 0)
+assert hd.open_dataset(sys.argv[1]).channels == ["body_force"]
+assert ht.GridDataset(sys.argv[1], None).x_channels == ["sdf", "dirichlet_distance", "body_force_x", "body_force_y"]
 PY
 
 # ---- solve == generate on the same scene -----------------------------------------------------
