@@ -83,7 +83,6 @@
 #include "hypershape/mesh/boundary_mesher.hpp"
 #include "hypershape/mesh/quality.hpp"
 #include "hypershape/mesh/gmsh_mesher.hpp"
-#include "hypershape/physics/gaussian_traction.hpp"
 #include "hypershape/physics/problem.hpp"
 #include "hypershape/physics/registry.hpp"
 #include "hypershape/sampling/field_error.hpp"
@@ -403,7 +402,6 @@ SolvedSetting solve_setting(const hs::factory::ShapeSample& shape, const hs::con
                             double repeat_above, const std::string& prefix, bool verbose,
                             const AfterLoad& after_load = {}) {
   SolvedSetting out;
-  const int d = shape.mesh.dim;
   reset_peak_rss();
   out.rss_before_mib = proc_status_mib("VmRSS:");
   std::vector<std::pair<std::string, std::string>> petsc = s.petsc;
