@@ -185,12 +185,12 @@ class DrawnParams {
   void add(const LoadCase& lc) {
     for (const auto& v : drawn_values(cfg_, shape_id_, lc.load_id))
       if (v.per_load || lc.load_id == 0) values_[v.name].push_back(v.value);
-    const int d = cfg_.shapes.dim;
+    const auto tractions = cfg_.scene.find("gaussian_traction");
     for (std::size_t k = 0; k < lc.more_centers.size(); ++k) {
-      auto& c = placements_["gaussian_traction." + std::to_string(k + 1) + "/center"];
-      auto& g = placements_["gaussian_traction." + std::to_string(k + 1) + "/direction"];
-      c.insert(c.end(), lc.more_centers[k].begin(), lc.more_centers[k].begin() + d);
-      g.insert(g.end(), lc.more_directions[k].begin(), lc.more_directions[k].begin() + d);
+      const auto& given = cfg_.scene.effects[tractions.at(k + 1)].params;  // a fixed one is in the scene
+      const std::string label = "gaussian_traction." + std::to_string(k + 1);
+      if (!given.count("center")) append(placements_[label + "/center"], lc.more_centers[k]);
+      if (!given.count("direction")) append(placements_[label + "/direction"], lc.more_directions[k]);
     }
   }
   void store(std::vector<io::Array>& arrays) {
@@ -204,6 +204,9 @@ class DrawnParams {
   }
 
  private:
+  void append(std::vector<double>& to, const std::array<double, 3>& v) const {
+    to.insert(to.end(), v.begin(), v.begin() + cfg_.shapes.dim);
+  }
   const config::DatasetConfig& cfg_;
   std::int64_t shape_id_;
   int n_loads_;
@@ -344,6 +347,7 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
       p_n[L * std::size_t(d) + std::size_t(k)] = lc.center[std::size_t(k)];
       g[L * std::size_t(d) + std::size_t(k)] = lc.direction[std::size_t(k)];
     }
+    drawn.add(lc);  // before anything that may fail: one row per load case
     solver::TargetResult r;
     std::string failure;
     try {
@@ -351,7 +355,6 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
         auto t = out.times.scope("setup");
         sp.set_load_case(cfg, shape, lc);
       }
-      drawn.add(lc);
       normaliser[L] = first_normaliser(*problem);
       nl->reset();
       r = nl->solve_for_target(lc.target);
