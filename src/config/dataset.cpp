@@ -202,6 +202,14 @@ void placeholders(const physics::SceneSpec& spec, int dim, std::size_t i, physic
   }
 }
 
+/// Effect `i` of the dataset scene at the low end of its draws, placeholders filled in.
+physics::EffectPtr make_one(const DatasetConfig& c, std::size_t i) {
+  const auto resolved = physics::resolve(
+      c.scene, [](std::size_t, const std::string&, const physics::Draw& d) { return d.low(); },
+      [&](std::size_t k, physics::EffectParams& p) { placeholders(c.scene, c.shapes.dim, k, p); });
+  return physics::build_effect(resolved[i], c.shapes.dim);
+}
+
 /// Rejects, before any work, a dataset scene the factory cannot run: unknown effects or keys,
 /// values out of range at either end of a distribution, draws per load case of what is set up
 /// once per shape, no or two materials, no dirichlet_patch, no load scaled by alpha.
@@ -217,6 +225,10 @@ void check_dataset_scene(DatasetConfig& c) {
     throw InputError(c.source, patch.path + ".center", "drawn on each shape's boundary by the factory: leave it out");
   std::vector<physics::EffectPtr> built;
   for (int corner = 0; corner < 2; ++corner) {
+    if (corner == 0)  // before the checks of the whole: copies of a material are two materials
+      for (std::size_t i = 0; i < spec.effects.size(); ++i)
+        if (spec.effects[i].count && spec.effects[i].copy == 0 && !make_one(c, i)->has_load())
+          throw InputError(c.source, spec.effects[i].path + ".count", "only a load (a traction, a body force) has copies");
     const auto resolved = physics::resolve(
         spec, [&](std::size_t, const std::string&, const physics::Draw& d) { return corner ? d.high() : d.low(); },
         [&](std::size_t i, physics::EffectParams& p) { placeholders(spec, dim, i, p); });

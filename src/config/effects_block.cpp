@@ -55,6 +55,29 @@ physics::ParamValue parse_value(const YamlBlock& b, const std::string& key, bool
   }
 }
 
+/// `count`: an integer >= 1 or {choice: [integers >= 1], sample: ...}, as a Draw.
+physics::Draw count_draw(const YamlBlock& b, bool allow_draws) {
+  physics::Draw d{physics::Draw::Kind::choice, {}, physics::Draw::Per::load};
+  const physics::ParamValue v = parse_value(b, "count", allow_draws);
+  if (const auto* n = std::get_if<double>(&v)) d.values = {*n}, d.per = physics::Draw::Per::shape;
+  else if (const auto* c = std::get_if<physics::Draw>(&v); c && c->kind == physics::Draw::Kind::choice) d = *c;
+  else b.fail("count", "must be an integer >= 1 or {choice: [integers >= 1], sample: shape | load}");
+  for (double x : d.values)
+    if (!(x >= 1 && x <= 100 && x == std::floor(x))) b.fail("count", "copies must be integers in [1, 100]");
+  return d;
+}
+
+/// An effect with a count: copies 0..max-1 (labels name.k), each active below the count drawn.
+void add_copies(physics::SceneSpec& s, const physics::EffectSpec& e) {
+  const int n = int(e.count->high());
+  for (int k = 0; k < n; ++k) {
+    physics::EffectSpec c = e;
+    c.label = e.name + "." + std::to_string(k);
+    c.copy = k;
+    s.effects.push_back(std::move(c));
+  }
+}
+
 physics::EffectSpec parse_effect(const YAML::Node& node, const std::string& file, const std::string& name,
                                  const std::string& path, bool allow_draws) {
   physics::EffectSpec e;
@@ -67,6 +90,10 @@ physics::EffectSpec parse_effect(const YAML::Node& node, const std::string& file
   if (!node || node.IsNull()) return e;
   for (const auto& kv : node) {
     const std::string key = kv.first.Scalar();
+    if (key == "count") {
+      e.count = count_draw(b, allow_draws);
+      continue;
+    }
     if (key == "scale") {
       const std::string s = b.text("scale");
       if (s != "alpha" && s != "fixed") b.fail("scale", "must be alpha (scaled by the tuned load factor) or fixed");
@@ -91,13 +118,16 @@ physics::SceneSpec parse_effects(const YamlBlock& block, bool allow_draws) {
     block.get(name);  // mark used; the registry checks the name when the effect is built
     const std::string path = join(block.path(), name);
     if (!kv.second.IsSequence()) {
-      s.effects.push_back(parse_effect(kv.second, block.file(), name, path, allow_draws));
+      auto e = parse_effect(kv.second, block.file(), name, path, allow_draws);
+      if (e.count) add_copies(s, e);
+      else s.effects.push_back(std::move(e));
       continue;
     }
     if (kv.second.size() == 0) block.fail(name, "an empty list: give at least one entry or leave the effect out");
     for (std::size_t k = 0; k < kv.second.size(); ++k) {
       auto e = parse_effect(kv.second[k], block.file(), name, path + "[" + std::to_string(k) + "]", allow_draws);
       e.label = name + "." + std::to_string(k);
+      if (e.count) block.fail(name + "[" + std::to_string(k) + "].count", "a count is for an effect given once, not in a list");
       s.effects.push_back(std::move(e));
     }
   }
@@ -114,7 +144,8 @@ std::string effects_yaml(const physics::SceneSpec& spec) {
     open_list.clear();
   };
   for (const auto& e : spec.effects) {
-    const bool listed = e.label != e.name;
+    if (e.count && e.copy > 0) continue;  // written once, with its count
+    const bool listed = e.label != e.name && !e.count;
     if (!listed || open_list != e.name) {
       close_list();
       out << YAML::Key << e.name << YAML::Value;
@@ -137,6 +168,10 @@ std::string effects_yaml(const physics::SceneSpec& spec) {
       }
     }
     if (e.scale_given) out << YAML::Key << "scale" << YAML::Value << (e.scaled ? "alpha" : "fixed");
+    if (e.count)
+      out << YAML::Key << "count" << YAML::Value << YAML::BeginMap << YAML::Key << "choice" << YAML::Value
+          << YAML::Flow << e.count->values << YAML::Key << "sample" << YAML::Value
+          << (e.count->per == physics::Draw::Per::shape ? "shape" : "load") << YAML::EndMap;
     out << YAML::EndMap;
   }
   close_list();

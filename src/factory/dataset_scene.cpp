@@ -28,6 +28,9 @@ double draw_parameter(const config::DatasetConfig& cfg, std::int64_t shape_id, i
 std::vector<DrawnValue> drawn_values(const config::DatasetConfig& cfg, std::int64_t shape_id, int load_id) {
   std::vector<DrawnValue> out;
   for (std::size_t i = 0; i < cfg.scene.effects.size(); ++i)
+    if (const auto& e = cfg.scene.effects[i]; e.count && e.copy == 0)
+      out.push_back({e.name + "/count", e.count->per == physics::Draw::Per::load, double(active_copies(cfg, shape_id, load_id, i))});
+  for (std::size_t i = 0; i < cfg.scene.effects.size(); ++i)
     for (const auto& [key, value] : cfg.scene.effects[i].params)
       if (const auto* d = std::get_if<physics::Draw>(&value))
         out.push_back({cfg.scene.effects[i].label + "/" + key, d->per == physics::Draw::Per::load,
@@ -42,6 +45,12 @@ ShapeConfig shape_config(const config::DatasetConfig& cfg, std::int64_t shape_id
       if (const auto* d = std::get_if<physics::Draw>(&it->second))
         s.dirichlet_radius = draw_parameter(cfg, shape_id, 0, i, "radius", *d);
   return s;
+}
+
+int active_copies(const config::DatasetConfig& cfg, std::int64_t shape_id, int load_id, std::size_t effect) {
+  const auto& e = cfg.scene.effects[effect];
+  if (!e.count) return 1;
+  return int(draw_parameter(cfg, shape_id, load_id, effect - std::size_t(e.copy), "count", *e.count));
 }
 
 int n_tractions(const config::DatasetConfig& cfg) { return int(cfg.scene.find("gaussian_traction").size()); }
@@ -65,7 +74,10 @@ std::vector<physics::ResolvedEffect> resolve_scene(const config::DatasetConfig& 
     if (!e.params.count("direction"))
       p.set("direction", first(k == 0 ? lc.direction : lc.more_directions.at(k - 1), d));
   };
-  return physics::resolve(cfg.scene, draw, placements);
+  auto out = physics::resolve(cfg.scene, draw, placements);
+  for (std::size_t i = 0; i < out.size(); ++i)
+    out[i].active = cfg.scene.effects[i].copy < active_copies(cfg, shape.shape_id, lc.load_id, i);
+  return out;
 }
 
 void ShapeProblem::set_load_case(const config::DatasetConfig& cfg, const ShapeSample& shape, const LoadCase& lc) {

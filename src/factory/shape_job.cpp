@@ -162,6 +162,7 @@ class Channels {
     const std::size_t n = points.size() / std::size_t(d);
     for (std::size_t i : c.effects) {
       const physics::Effect& e = *p.effects()[i];
+      if (!e.active()) continue;
       const double scale = e.scaled() ? alpha : 1.0;
       for (std::size_t a = 0; a < n; ++a) {
         if (neumann && e.channel_on_boundary() && !(*neumann)[a]) continue;

@@ -93,7 +93,7 @@ void Problem::assemble_loads(bool scaled, Vec f) const {
   HS_PETSC(VecZeroEntries(f));
   LocalArray fl(dm(), true);
   for (auto& e : effects_)
-    if (e->has_load() && e->scaled() == scaled) e->add_load(*space_, fl.array());
+    if (e->has_load() && e->active() && e->scaled() == scaled) e->add_load(*space_, fl.array());
   fl.release();
   HS_PETSC(DMLocalToGlobal(dm(), fl.vec(), ADD_VALUES, f));
 }
@@ -201,7 +201,7 @@ Resultants Problem::resultants(Vec u, double load_factor) const {
   bool ok = true;
   for (auto& eff : effects_) {
     if (eff->has_energy()) ok = ok && eff->add_residual(*space_, ul.array(), fi.array());
-    if (eff->has_load()) eff->add_load(*space_, eff->scaled() ? fe.array() : ff.array());
+    if (eff->has_load() && eff->active()) eff->add_load(*space_, eff->scaled() ? fe.array() : ff.array());
   }
   Resultants out;
   out.admissible = all_ranks(comm(), ok);

@@ -109,6 +109,7 @@ EffectPtr build_effect(const ResolvedEffect& r, int dim) {
   if (r.scale_given && !e->has_load())
     r.params.fail("scale", "only a load (a traction, a body force) has a scale");
   e->set_scaled(r.scaled);
+  e->set_active(r.active);
   return e;
 }
 

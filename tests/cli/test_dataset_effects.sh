@@ -8,6 +8,7 @@
 #    traction and body_force at the nodes and on the grid; the torch Datasets serve them;
 #  - `hypershape solve` on the same scene (the shape's mesh written as a .msh, the drawn
 #    values fixed) gives the same solution as `generate`;
+#  - a count of tractions drawn per load case (copies beyond it inactive);
 #  - a scene without a traction stores no traction, p_N, g or I_N (only the effects called for);
 #  - bad scenes stop before any work: exit code 2, the key path named, nothing written.
 # Needs HYPERSHAPE_BIN and HYPERSHAPE_SOURCE_DIR (set by CTest).
@@ -73,6 +74,29 @@ b, alpha = g["body_force"][...], g["alpha"][...]
 assert np.allclose(b[:, :, 1], -alpha[:, None]) and np.all(b[:, :, 0] == 0)
 assert hd.open_dataset(sys.argv[1]).channels == ["body_force"]
 assert ht.GridDataset(sys.argv[1], None).x_channels == ["sdf", "dirichlet_distance", "body_force_x", "body_force_y"]
+PY
+
+# ---- a count of tractions drawn per load case ------------------------------------------------
+count_cfg() {  # $1: the gaussian_traction entry
+  printf 'preset: random2d\nname: count\nseed: 9\nshapes: {count: 1, h: 0.1}\nloads: {count: 6}\nrepresentations: {grid_size: 8}\neffects:\n  neo_hookean: {E: 500, nu: 0.49}\n  dirichlet_patch: {radius: 0.5}\n  gaussian_traction: %s\n' "$1"
+}
+count_cfg '{gamma: 0.2, count: {choice: [1, 2, 3], sample: load}}' > "$work/count.yaml"
+count_cfg '{gamma: 0.2}' > "$work/one.yaml"
+"$bin" -q generate "$work/count.yaml" --progress 0 -o "$work/count" || fail "count run"
+"$bin" -q generate "$work/one.yaml" --progress 0 -o "$work/one" || fail "one-traction run"
+/usr/bin/python3 - "$work/count" "$work/one" <<'PY' && ok "a drawn count of tractions: load cases with count 1 are the one-traction dataset's (to 1e-6), the others not" || fail "drawn count"
+import sys, h5py, numpy as np
+a = h5py.File(f"{sys.argv[1]}/shards/shard-000000.h5")["shapes/000000"]
+b = h5py.File(f"{sys.argv[2]}/shards/shard-000000.h5")["shapes/000000"]
+n = a["params/gaussian_traction/count"][...]
+assert set(n) <= {1, 2, 3} and len(set(n)) > 1, n
+assert list(a["loads/status"][:]) == [1] * 6 and list(b["loads/status"][:]) == [1] * 6
+for l, k in enumerate(n):
+    ua, ub = a["loads/displacement"][l], b["loads/displacement"][l]
+    d = np.abs(ua - ub).max() / np.abs(ub).max()
+    assert (d < 1e-6) == (k == 1), (l, k, d)
+    ta, tb = a["loads/traction"][l], b["loads/traction"][l]
+    assert (np.abs(ta - tb).max() <= 1e-6 * np.abs(tb).max()) == (k == 1), (l, k)
 PY
 
 # ---- solve == generate on the same scene -----------------------------------------------------
@@ -144,6 +168,9 @@ bad patch_center    "effects.dirichlet_patch.center"     "$nh\n  dirichlet_patch
 bad only_fixed      "no load scaled by alpha"            "$nh\n  dirichlet_patch: {radius: 0.5}\n  body_force: {value: [0, -1], scale: fixed}"
 bad scale_material  "effects.neo_hookean.scale"          "  neo_hookean: {E: 500, nu: 0.49, scale: fixed}\n$good_effects"
 bad scale_word      "effects.body_force.scale"           "$nh\n$good_effects\n  body_force: {value: [0, -1], scale: half}"
+bad count_list      "effects.gaussian_traction[0].count"  "$nh\n  dirichlet_patch: {radius: 0.5}\n  gaussian_traction: [{gamma: 0.2, count: 2}]"
+bad count_kind      "effects.gaussian_traction.count"    "$nh\n  dirichlet_patch: {radius: 0.5}\n  gaussian_traction: {gamma: 0.2, count: {uniform: [1, 3]}}"
+bad count_material  "effects.neo_hookean.count"          "  neo_hookean: {E: 500, nu: 0.49, count: 2}\n$good_effects"
 bad empty_list      "effects.gaussian_traction"          "$nh\n  dirichlet_patch: {radius: 0.5}\n  gaussian_traction: []"
 bad shorthand_mix   "material: a shorthand"              "$nh\n$good_effects" "material: {E: 400}\n"
 printf 'geometry: {base: circle}\neffects:\n  neo_hookean: {E: {uniform: [1, 2]}, nu: 0.49}\n  dirichlet_patch: {center: [1, 0], radius: 0.5}\n  gaussian_traction: {center: [-1, 0], direction: [0, 1], gamma: 0.2}\nload: {target: 0.3}\n' > "$work/draw_scene.yaml"

@@ -81,3 +81,15 @@ TEST_CASE("shorthands and effects do not mix in one config", "[config][effects]"
   CHECK(key_of(std::string(multi) + "loads: {gamma: 0.1}\n") == "loads.gamma");
   CHECK(key_of(std::string(multi) + "shapes: {count: 2, dirichlet_radius: 0.3}\n").rfind("shapes", 0) == 0);
 }
+
+TEST_CASE("a count of copies: copies 0..max-1, written back once with the count", "[config][effects]") {
+  const std::string effects =
+      "effects:\n  neo_hookean: {E: 500, nu: 0.49}\n  dirichlet_patch: {radius: 0.5}\n"
+      "  gaussian_traction: {gamma: 0.2, count: {choice: [1, 3], sample: load}}\n";
+  const auto c = config::parse_dataset_text("preset: random2d\n" + effects, "<test>");
+  const auto tractions = c.scene.find("gaussian_traction");
+  REQUIRE(tractions.size() == 3);
+  CHECK(c.scene.effects[tractions[2]].label == "gaussian_traction.2");
+  CHECK(c.scene.effects[tractions[2]].copy == 2);
+  CHECK(config::effects_yaml(c.scene).find("count: {choice: [1, 3], sample: load}") != std::string::npos);
+}

@@ -37,6 +37,8 @@
 ///     - {gamma: 0.2}                        # centre and direction drawn per load case
 ///     - {gamma: {choice: [0.1, 0.2], sample: load}}
 ///   body_force: {value: [0, -0.5], scale: fixed}   # not scaled by the tuned alpha
+///   # or a drawn number of copies of a load: gaussian_traction: {gamma: 0.2,
+///   #   count: {choice: [1, 2, 3], sample: load}}  (copy k acts where k < the count)
 /// mesh: {degree: 1}               # P1 | P2; h: 3D only, optional: the mesh's edge length when
 ///                                 # coarser than shapes.h (the shape is drawn at shapes.h, its
 ///                                 # surface remeshed at h; see factory::ShapeConfig::mesh_h)

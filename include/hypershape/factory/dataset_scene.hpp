@@ -35,7 +35,10 @@ std::vector<DrawnValue> drawn_values(const config::DatasetConfig& cfg, std::int6
 /// The shape family for shape `shape_id`: the config's, with the Dirichlet radius drawn when
 /// the scene draws it.
 ShapeConfig shape_config(const config::DatasetConfig& cfg, std::int64_t shape_id);
-/// Number of gaussian_traction effects of the scene (placements per load case).
+/// How many copies of effect `effect` act in (shape, load) (1 without a count; the count is
+/// drawn from the stream of its copy 0, key "count", and stored as params/<name>/count).
+int active_copies(const config::DatasetConfig& cfg, std::int64_t shape_id, int load_id, std::size_t effect);
+/// Number of gaussian_traction effects of the scene, copies included (placements per load case).
 int n_tractions(const config::DatasetConfig& cfg);
 /// The scene resolved for `shape` and load case `lc` (not collective).
 std::vector<physics::ResolvedEffect> resolve_scene(const config::DatasetConfig& cfg, const ShapeSample& shape,

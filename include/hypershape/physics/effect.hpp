@@ -69,9 +69,13 @@ class Effect {
   /// Whether the load factor scales this effect's load (f_ext) or it is fixed (f_fixed).
   bool scaled() const { return scaled_; }
   void set_scaled(bool scaled) { scaled_ = scaled; }
+  /// An inactive load contributes nothing (a copy beyond the count drawn for this load case).
+  bool active() const { return active_; }
+  void set_active(bool active) { active_ = active; }
 
  private:
   bool scaled_ = true;
+  bool active_ = true;
 };
 
 using EffectPtr = std::unique_ptr<Effect>;

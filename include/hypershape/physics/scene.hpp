@@ -10,6 +10,7 @@
 
 #include <functional>
 #include <map>
+#include <optional>
 #include <memory>
 #include <set>
 #include <string>
@@ -48,6 +49,10 @@ struct EffectSpec {
   std::map<std::string, ParamValue> params;
   bool scaled = true; ///< a load: scaled by the load factor (scale: alpha) or fixed (scale: fixed)
   bool scale_given = false;
+  /// `count: {choice: [1, 2, 3], sample: load}`: the effect is copies 0..max-1 (labels name.k)
+  /// and copy k is active where k < the count drawn (per shape or load case).
+  std::optional<Draw> count;
+  int copy = 0;
 };
 
 struct SceneSpec {
@@ -87,6 +92,7 @@ struct ResolvedEffect {
   EffectParams params;
   bool scaled = true;
   bool scale_given = false;
+  bool active = true;  ///< false: built but contributes nothing (EffectSpec::count)
 };
 
 /// Supplies the value of a drawn parameter: (effect index, key, its draw) -> number.
