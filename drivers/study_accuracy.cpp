@@ -83,7 +83,6 @@
 #include "hypershape/mesh/boundary_mesher.hpp"
 #include "hypershape/mesh/quality.hpp"
 #include "hypershape/mesh/gmsh_mesher.hpp"
-#include "hypershape/physics/gaussian_traction.hpp"
 #include "hypershape/physics/problem.hpp"
 #include "hypershape/physics/registry.hpp"
 #include "hypershape/sampling/field_error.hpp"
@@ -392,8 +391,7 @@ struct SolvedSetting {
   std::string error;
 };
 
-/// Builds the problem of `shape` (the factory's effects: material, Dirichlet patch, Gaussian
-/// traction) and solves every load case with setting `s`, `repeats` times each (fewer when a
+/// Builds the problem of `shape` from the dataset's scene (factory::make_shape_problem) and solves every load case with setting `s`, `repeats` times each (fewer when a
 /// run takes longer than `repeat_above` seconds). Never throws for a numerical failure.
 /// Called after load case `l` of a setting was solved (at its target), with the solver still
 /// at that state: the same-load pass continues the reference from there.
@@ -404,7 +402,6 @@ SolvedSetting solve_setting(const hs::factory::ShapeSample& shape, const hs::con
                             double repeat_above, const std::string& prefix, bool verbose,
                             const AfterLoad& after_load = {}) {
   SolvedSetting out;
-  const int d = shape.mesh.dim;
   reset_peak_rss();
   out.rss_before_mib = proc_status_mib("VmRSS:");
   std::vector<std::pair<std::string, std::string>> petsc = s.petsc;
@@ -415,7 +412,6 @@ SolvedSetting solve_setting(const hs::factory::ShapeSample& shape, const hs::con
     so.quadrature_degree = s.quadrature;
     auto sp = hs::factory::make_shape_problem(PETSC_COMM_SELF, cfg, shape, cases[0], so);
     hs::physics::Problem& problem = *sp.problem;
-    hs::physics::GaussianTraction* traction = sp.traction;
     // PETSc options of this setting, under its own prefix (removed afterwards). Beyond
     // kAutoMumpsDofs unknowns, settings off the baseline mesh that do not choose a linear solver
     // get MUMPS LDL^T: with PETSc's own Cholesky (the one-rank default, fastest at the default's
@@ -448,9 +444,7 @@ SolvedSetting solve_setting(const hs::factory::ShapeSample& shape, const hs::con
       LoadOutcome lo;
       for (int r = 0; r < repeats; ++r) {
         const double t1 = hs::core::now_seconds(), c1 = cpu_now();
-        traction->set(std::vector<double>(lc.center.begin(), lc.center.begin() + d),
-                      std::vector<double>(lc.direction.begin(), lc.direction.begin() + d));
-        problem.reassemble_load();
+        sp.set_load_case(cfg, shape, lc);
         nl.reset();
         if (s.linear_model) {
           // The small-strain model: K(0) du = f_ext, scaled so that max|u| = target.

@@ -113,6 +113,12 @@ class Shape:
                 self.grid["inside"] = self.grid["inside"].astype(bool)
         self.status = g["loads/status"][...]
         self.reasons = [_text(r) for r in g["loads/reason"][...]]
+        # Drawn scene parameters: "<effect label>/<key>" -> (1,) per shape or (L,) per load case
+        # (placements of further tractions: (L, d)).
+        self.params = {}
+        if "params" in g:
+            g["params"].visititems(lambda n, o: self.params.__setitem__(n, o[...])
+                                   if isinstance(o, h5py.Dataset) else None)
 
     @property
     def n_nodes(self):
@@ -139,8 +145,12 @@ class Sample:
       grid         dict: sdf, dirichlet_distance, inside (N,)*d (float32, float32, bool);
                    traction, displacement (N,)*d + (d,) float32; numpy 'ij' order, x index first
       alpha, target, max_displacement, min_det_f, traction_normaliser (float)
-      p_n (d,), g (d,) float64; newton_iterations, solves, failed_increments,
-      recovery_iterations (int)
+      p_n (d,), g (d,) float64 (the first traction's; None without one); newton_iterations,
+      solves, failed_increments, recovery_iterations (int)
+      params       dict: drawn scene parameter "<effect label>/<key>" -> its value for this
+                   load case (float, or (d,) for a further traction's centre/direction)
+    The input channels the scene's effects bring (Dataset.channels: "traction", "body_force",
+    ...) are in point_cloud (n, d) and grid (N,)*d + (d,) under their names.
     Arrays belong to the Sample (per-shape arrays are shared by the samples of one shape: do
     not modify them in place).
     """
@@ -169,7 +179,10 @@ class Dataset:
     Attributes: path, manifest (dict), splits (dict: train/val/test -> sorted shape ids, plus
     seed and fractions), stats (dict, stats.json), config (dict parsed from dataset.yaml, or None
     without PyYAML), config_text (str), name, dim, n_shapes, n_loads (load cases per shape),
-    shard_size, grid_size (N, or None if no grid is stored), failed_shapes (list of ids).
+    shard_size, grid_size (N, or None if no grid is stored), failed_shapes (list of ids),
+    channels (input channels per load case the scene's effects bring, e.g. ["traction",
+    "body_force"]: loads/<name> at the nodes, loads/grid_<name> on the grid), scene_text (the
+    effects solved, YAML, as stored in the shards).
     """
 
     def __init__(self, path, cache_shapes=4):
@@ -211,11 +224,16 @@ class Dataset:
         self._shape_cache = OrderedDict()
         self._status = None  # shape id -> (L,) int8, read on demand
         self.grid_size = None
+        self.channels, self.scene_text = [], ""
         ok = self.shape_ids(include_failed=False)
         if ok:
             g = self._group(ok[0])
             if "grid/sdf" in g:
                 self.grid_size = int(g["grid/sdf"].shape[0])
+            self.channels = _channels_of(g["loads"])
+            f = self._file(self._shard_of(ok[0]))
+            if "scene" in f:
+                self.scene_text = _text(f["scene"][()])
 
     # ---- handles ---------------------------------------------------------------------------
     def _file(self, k):
@@ -343,7 +361,7 @@ class Dataset:
         kw = dict(shape_id=shape_id, load_id=load_id, dim=self.dim, status=int(sh.status[load_id]),
                   reason=sh.reasons[load_id], nodes=sh.nodes, cells=sh.cells,
                   dirichlet_mask=sh.dirichlet_mask, neumann_mask=sh.neumann_mask,
-                  displacement=None, point_cloud={}, grid={}, p_n=None, g=None)
+                  displacement=None, point_cloud={}, grid={}, p_n=None, g=None, params={})
         for k in _LOAD_SCALARS:
             kw[k] = 0 if k in _LOAD_COUNTS else float("nan")
         if not sh.ok:
@@ -354,16 +372,19 @@ class Dataset:
             if k in gl:
                 v = gl[k][load_id]
                 kw[k] = int(v) if np.issubdtype(gl[k].dtype, np.integer) else float(v)
-        kw["p_n"], kw["g"] = gl["p_n"][load_id], gl["g"][load_id]
+        if "p_n" in gl:
+            kw["p_n"], kw["g"] = gl["p_n"][load_id], gl["g"][load_id]
         kw["displacement"] = gl["displacement"][load_id]
+        kw["params"] = {k: (v[0] if v.shape == (1,) else v[load_id]) for k, v in sh.params.items()}
         if point_cloud and sh.point_cloud:
             pc = dict(sh.point_cloud)
-            if "traction" in gl:
-                pc["traction"] = gl["traction"][load_id]
+            for k in self.channels:
+                if k in gl:
+                    pc[k] = gl[k][load_id]
             kw["point_cloud"] = pc
         if grid and sh.grid:
             gd = dict(sh.grid)
-            for k in ("traction", "displacement"):
+            for k in self.channels + ["displacement"]:
                 if f"grid_{k}" in gl:
                     gd[k] = gl[f"grid_{k}"][load_id]
             kw["grid"] = gd
@@ -391,6 +412,17 @@ class Dataset:
         t = self.manifest["totals"]
         return (f"Dataset({self.name!r}, {self.dim}D, {self.n_shapes} shapes x {self.n_loads} load cases, "
                 f"{t['load_cases_converged']} converged, {t['load_cases_failed']} failed, {self.path})")
+
+
+def _channels_of(loads):
+    """The input channels of a shape's loads group: fields per load case other than the
+    displacement (at the nodes, or on the grid only), traction first."""
+    names = set()
+    for k, v in loads.items():
+        base = k[5:] if k.startswith("grid_") else k
+        if isinstance(v, h5py.Dataset) and v.ndim >= 3 and base != "displacement":
+            names.add(base)
+    return sorted(names, key=lambda n: (n != "traction", n))
 
 
 def open_dataset(path, cache_shapes=4):

@@ -21,7 +21,10 @@ cases and failed shapes are never served. Items are dicts of tensors (d: dimensi
 points per axis, n: mesh nodes of the shape, m: cells, k: nodes per cell):
 
   GridDataset
-    "x"        (2 + d, N, ..., N) float32  channels: sdf, dirichlet_distance, traction_1..d
+    "x"        (c, N, ..., N) float32  channels (Dataset.x_channels): sdf, dirichlet_distance,
+                                       then d components of each input channel the dataset's
+                                       effects bring (reader.channels: traction, body_force, ...;
+                                       c = 2 + d for the paper's presets: traction only)
     "y"        (d, N, ..., N)     float32  displacement_1..d (closest-boundary-point extension
                                            outside the body)
     "inside"   (N, ..., N)        bool     grid point in the body
@@ -30,8 +33,8 @@ points per axis, n: mesh nodes of the shape, m: cells, k: nodes per cell):
     "nodes" (n, d) float64, "u_mesh" (n, d) float64, "cells" (m, k) int64, "n_points" int64
   PointCloudDataset
     "pos"      (n, d)     float32  node coordinates (the point cloud), not normalised
-    "x"        (n, 2 + d) float32  sdf, dirichlet_distance, traction_1..d at the nodes (traction
-                                   zero off the Neumann boundary)
+    "x"        (n, c) float32  sdf, dirichlet_distance, then each input channel at the nodes
+                               (x_channels; traction zero off the Neumann boundary)
     "y"        (n, d)     float32  displacement at the nodes
     "n_points", "shape_id", "load_id"  int64
     with_mesh=True adds "cells" (m, k) int64 (for rel_h1).
@@ -84,7 +87,7 @@ def _field_norm(reader, field, mode, n_comp):
 
 
 class _Base(torch.utils.data.Dataset):
-    _fields = None  # (sdf, dirichlet distance, traction, displacement) names in stats.json
+    _fields = None  # (sdf, dirichlet distance, channel prefix, displacement) names in stats.json
 
     def __init__(self, path, split="train", normalize=None, dtype=torch.float32, with_mesh=False):
         if normalize not in NORMALIZATIONS:
@@ -93,8 +96,14 @@ class _Base(torch.utils.data.Dataset):
         self.split, self.normalize, self.dtype, self.with_mesh = split, normalize, dtype, with_mesh
         self.dim = d = self.reader.dim
         self.index = self.reader.keys(split)  # (shape_id, load_id), converged only
-        sdf, dd, tr, u = self._fields
-        xm, xs = zip(*(_field_norm(self.reader, f, normalize, c) for f, c in ((sdf, 1), (dd, 1), (tr, d))))
+        sdf, dd, prefix, u = self._fields
+        # Inputs: sdf, dirichlet distance, then every channel the dataset's effects bring
+        # (traction, body force, ...: Dataset.channels), d components each.
+        self.channels = list(self.reader.channels)
+        self.x_channels = ["sdf", "dirichlet_distance"] + [
+            f"{c}_{k}" for c in self.channels for k in "xyz"[:d]]
+        fields = [(sdf, 1), (dd, 1)] + [(prefix + c, d) for c in self.channels]
+        xm, xs = zip(*(_field_norm(self.reader, f, normalize, c) for f, c in fields))
         ym, ys = _field_norm(self.reader, u, normalize, d)
         self.x_mean = torch.tensor(np.concatenate(xm), dtype=dtype)
         self.x_std = torch.tensor(np.concatenate(xs), dtype=dtype)
@@ -113,7 +122,7 @@ class _Base(torch.utils.data.Dataset):
 class GridDataset(_Base):
     """The grid form of a split: see the module docstring for the item layout."""
 
-    _fields = ("grid_sdf", "grid_dirichlet_distance", "grid_traction", "grid_displacement")
+    _fields = ("grid_sdf", "grid_dirichlet_distance", "grid_", "grid_displacement")
 
     def __init__(self, path, split="train", normalize=None, dtype=torch.float32, with_mesh=False):
         super().__init__(path, split, normalize, dtype, with_mesh)
@@ -130,7 +139,7 @@ class GridDataset(_Base):
         g = s.grid
         d = self.dim
         cl = lambda a: np.moveaxis(a, -1, 0)  # noqa: E731  (N.., c) -> (c, N..)
-        x = np.concatenate([g["sdf"][None], g["dirichlet_distance"][None], cl(g["traction"])], axis=0)
+        x = np.concatenate([g["sdf"][None], g["dirichlet_distance"][None]] + [cl(g[c]) for c in self.channels], axis=0)
         x = (torch.as_tensor(x, dtype=self.dtype) - self._xm) / self._xs
         y = (torch.as_tensor(cl(g["displacement"]), dtype=self.dtype) - self._ym) / self._ys
         item = {"x": x, "y": y, "inside": torch.as_tensor(g["inside"]),
@@ -138,7 +147,7 @@ class GridDataset(_Base):
         if self.with_mesh:
             item.update(nodes=torch.as_tensor(s.nodes), u_mesh=torch.as_tensor(s.displacement),
                         cells=torch.as_tensor(s.cells), n_points=torch.tensor(len(s.nodes)))
-        assert x.shape == (2 + d,) + (self.grid_size,) * d
+        assert x.shape == (len(self.x_channels),) + (self.grid_size,) * d
         return item
 
     def denormalize(self, y):
@@ -149,7 +158,7 @@ class GridDataset(_Base):
 class PointCloudDataset(_Base):
     """The point-cloud form of a split: see the module docstring for the item layout."""
 
-    _fields = ("sdf", "dirichlet_distance", "traction", "displacement")
+    _fields = ("sdf", "dirichlet_distance", "", "displacement")
 
     def __init__(self, path, split="train", normalize=None, dtype=torch.float32, with_mesh=False):
         super().__init__(path, split, normalize, dtype, with_mesh)
@@ -164,7 +173,7 @@ class PointCloudDataset(_Base):
         sid, lid = self.index[i]
         s = self.reader.sample(sid, lid, grid=False, point_cloud=True)
         pc = s.point_cloud
-        x = np.concatenate([pc["sdf"][:, None], pc["dirichlet_distance"][:, None], pc["traction"]], axis=1)
+        x = np.concatenate([pc["sdf"][:, None], pc["dirichlet_distance"][:, None]] + [pc[c] for c in self.channels], axis=1)
         x = (torch.as_tensor(x, dtype=self.dtype) - self.x_mean) / self.x_std
         y = (torch.as_tensor(s.displacement, dtype=self.dtype) - self.y_mean) / self.y_std
         item = {"pos": torch.as_tensor(s.nodes, dtype=self.dtype), "x": x, "y": y,

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "hypershape/mesh/surface_file.hpp"
+#include "effects_block.hpp"
 #include "solver_block.hpp"
 #include "yaml_block.hpp"
 
@@ -16,7 +17,7 @@ namespace hypershape::config {
 namespace {
 
 void parse_shapes(const YamlBlock& b, const std::string& base_dir, factory::ShapeConfig& s,
-                  std::int64_t& count) {
+                  std::int64_t& count, bool scene_given) {
   // count is read first (it is the first error to report) but a directory family may leave it
   // out: then it is the number of files.
   const bool has_count = b.has("count");
@@ -101,7 +102,9 @@ void parse_shapes(const YamlBlock& b, const std::string& base_dir, factory::Shap
   optional_number("nodes_per_sigma", s.deformation.nodes_per_sigma, 2.0, 16.0);
   s.h = b.number("h");
   if (!(s.h >= 0.005 && s.h <= 0.5)) b.fail("h", "must be in [0.005, 0.5]");
-  s.dirichlet_radius = b.number("dirichlet_radius");
+  if (scene_given && b.has("dirichlet_radius"))
+    b.fail("dirichlet_radius", "a shorthand of effects.dirichlet_patch.radius: with effects: set it there");
+  if (!scene_given) s.dirichlet_radius = b.number("dirichlet_radius");
   if (!(s.dirichlet_radius >= 0.0 && s.dirichlet_radius <= 2.0))
     b.fail("dirichlet_radius", "must be in [0, 2] (0: no Dirichlet patch)");
   optional_number("max_turn_deg", s.max_turn_deg, 2.0, 45.0);
@@ -174,6 +177,98 @@ bool flag(const YamlBlock& b, const std::string& key, bool fallback) {
   return b.has(key) ? b.boolean(key) : fallback;
 }
 
+/// The scene the shorthands stand for: the paper's three effects.
+physics::SceneSpec shorthand_scene(const DatasetConfig& c, const std::string& source) {
+  physics::SceneSpec s;
+  s.source = source;
+  auto add = [&](const char* name, std::map<std::string, physics::ParamValue> params) {
+    s.effects.push_back({name, name, std::string("effects.") + name, std::move(params), true, false});
+  };
+  add("neo_hookean", {{"E", c.material.E}, {"nu", c.material.nu}});
+  if (c.shapes.dirichlet_radius > 0) add("dirichlet_patch", {{"radius", c.shapes.dirichlet_radius}});
+  add("gaussian_traction", {{"gamma", c.loads.gamma}});
+  return s;
+}
+
+/// Placeholders for what the factory draws on each shape (for validation).
+void placeholders(const physics::SceneSpec& spec, int dim, std::size_t i, physics::EffectParams& p) {
+  const auto& e = spec.effects[i];
+  std::vector<double> e1(std::size_t(dim), 0.0);
+  e1[0] = 1.0;
+  if (e.name == "dirichlet_patch") p.set("center", std::vector<double>(std::size_t(dim), 0.0));
+  if (e.name == "gaussian_traction") {
+    if (!e.params.count("center")) p.set("center", e1);
+    if (!e.params.count("direction")) p.set("direction", e1);
+  }
+}
+
+/// Effect `i` of the dataset scene at the low end of its draws, placeholders filled in.
+physics::EffectPtr make_one(const DatasetConfig& c, std::size_t i) {
+  const auto resolved = physics::resolve(
+      c.scene, [](std::size_t, const std::string&, const physics::Draw& d) { return d.low(); },
+      [&](std::size_t k, physics::EffectParams& p) { placeholders(c.scene, c.shapes.dim, k, p); });
+  return physics::build_effect(resolved[i], c.shapes.dim);
+}
+
+/// Rejects, before any work, a dataset scene the factory cannot run: unknown effects or keys,
+/// values out of range at either end of a distribution, draws per load case of what is set up
+/// once per shape, no or two materials, no dirichlet_patch, no load scaled by alpha.
+void check_dataset_scene(DatasetConfig& c) {
+  const auto& spec = c.scene;
+  const int dim = c.shapes.dim;
+  const auto patches = spec.find("dirichlet_patch");
+  if (patches.size() != 1)
+    throw InputError(c.source, "effects", "a dataset needs exactly one dirichlet_patch (its centre is drawn "
+                                          "on each shape's boundary, and the mesh conforms to it)");
+  const auto& patch = spec.effects[patches[0]];
+  if (patch.params.count("center"))
+    throw InputError(c.source, patch.path + ".center", "drawn on each shape's boundary by the factory: leave it out");
+  std::vector<physics::EffectPtr> built;
+  for (int corner = 0; corner < 2; ++corner) {
+    if (corner == 0)  // before the checks of the whole: copies of a material are two materials
+      for (std::size_t i = 0; i < spec.effects.size(); ++i)
+        if (spec.effects[i].count && spec.effects[i].copy == 0 && !make_one(c, i)->has_load())
+          throw InputError(c.source, spec.effects[i].path + ".count", "only a load (a traction, a body force) has copies");
+    const auto resolved = physics::resolve(
+        spec, [&](std::size_t, const std::string&, const physics::Draw& d) { return corner ? d.high() : d.low(); },
+        [&](std::size_t i, physics::EffectParams& p) { placeholders(spec, dim, i, p); });
+    built = physics::build_effects(c.source, resolved, dim, true);
+  }
+  for (std::size_t i = 0; i < spec.effects.size(); ++i) {
+    const auto& e = spec.effects[i];
+    for (const auto& [key, value] : e.params) {
+      const auto* d = std::get_if<physics::Draw>(&value);
+      if (!d) continue;
+      if (d->per == physics::Draw::Per::load && !built[i]->has_load())
+        throw InputError(c.source, e.path + "." + key,
+                         "drawn per load case, but " + e.name + " is set up once per shape (sample: shape)");
+      if (e.name == "gaussian_traction" && (key == "center" || key == "direction"))
+        throw InputError(c.source, e.path + "." + key, "a vector: give it fixed, or leave it out to draw it");
+    }
+  }
+  const auto r = patch.params.find("radius");
+  if (r != patch.params.end()) {
+    if (const auto* d = std::get_if<physics::Draw>(&r->second)) c.shapes.dirichlet_radius = d->high();
+    else if (const auto* v = std::get_if<double>(&r->second)) c.shapes.dirichlet_radius = *v;
+  }
+  if (!(c.shapes.dirichlet_radius > 0 && c.shapes.dirichlet_radius <= 2.0))
+    throw InputError(c.source, patch.path + ".radius", "must be in (0, 2]");
+  for (auto i : spec.find("neo_hookean"))
+    for (auto [key, out] : {std::pair{"E", &c.material.E}, std::pair{"nu", &c.material.nu}})
+      if (auto it = spec.effects[i].params.find(key); it != spec.effects[i].params.end())
+        if (const auto* v = std::get_if<double>(&it->second)) *out = *v;
+}
+
+/// `effects:` replaces the preset's shorthands; the config's own may not be mixed with it.
+void drop_shorthands(YAML::Node& preset, const YAML::Node& own, const std::string& source) {
+  if (own["material"]) throw InputError(source, "material", "a shorthand of effects.neo_hookean: with effects: set it there");
+  if (own["loads"] && own["loads"]["gamma"])
+    throw InputError(source, "loads.gamma", "a shorthand of effects.gaussian_traction.gamma: with effects: set it there");
+  preset.remove("material");
+  if (preset["loads"]) preset["loads"].remove("gamma");
+  if (preset["shapes"]) preset["shapes"].remove("dirichlet_radius");
+}
+
 }  // namespace
 
 const char* default_dataset_text() {
@@ -211,6 +306,7 @@ DatasetConfig parse_dataset_text(const std::string& text, const std::string& sou
     if (!found) top.fail("preset", "unknown preset '" + c.preset + "'; presets: " + names);
     YAML::Node base = YAML::Load(found->text);
     root.remove("preset");
+    if (root["effects"]) drop_shorthands(base, root, source);
     // A preset's relative paths (base_file, base_dir) stay relative to the preset's directory
     // unless the config gives its own.
     if (!(root["shapes"] && (root["shapes"]["base_file"] || root["shapes"]["base_dir"])))
@@ -225,12 +321,23 @@ DatasetConfig parse_dataset_text(const std::string& text, const std::string& sou
   if (seed < 0) top.fail("seed", "must be >= 0");
   c.seed = std::uint64_t(seed);
   if (!top.has("shapes")) top.fail("shapes", "missing (the shape family is required)");
-  parse_shapes(YamlBlock(top.get("shapes"), source, "shapes"), base_dir, c.shapes, c.n_shapes);
+  c.scene_given = bool(root["effects"]);
+  if (c.scene_given && root["material"])
+    top.fail("material", "a shorthand of effects.neo_hookean: with effects: set it there");
+  if (c.scene_given && root["loads"] && root["loads"]["gamma"])
+    throw InputError(source, "loads.gamma", "a shorthand of effects.gaussian_traction.gamma: with effects: set it there");
+  parse_shapes(YamlBlock(top.get("shapes"), source, "shapes"), base_dir, c.shapes, c.n_shapes, c.scene_given);
   c.shapes.name = c.name;
   // The paper's widths: gamma 0.2 in 2D, 0.1 in 3D.
   c.loads.gamma = c.shapes.dim == 2 ? 0.2 : 0.1;
   parse_loads(YamlBlock(top.get("loads"), source, "loads"), c.loads);
   parse_material(YamlBlock(top.get("material"), source, "material"), c.material);
+  if (c.scene_given) {
+    c.scene = parse_effects(YamlBlock(top.get("effects"), source, "effects"), true);
+    check_dataset_scene(c);
+  } else {
+    c.scene = shorthand_scene(c, source);
+  }
   {
     YamlBlock m(top.get("mesh"), source, "mesh");
     if (m.has("degree")) {
@@ -290,7 +397,7 @@ DatasetConfig parse_dataset_text(const std::string& text, const std::string& sou
   }
   parse_solver_block(YamlBlock(top.get("solver"), source, "solver"), c.solver);
   parse_petsc_block(YamlBlock(top.get("petsc"), source, "petsc"), c.petsc);
-  top.allowed("preset, name, seed, shapes, loads, material, mesh, representations, split, output, solver, petsc");
+  top.allowed("preset, name, seed, shapes, loads, material, effects, mesh, representations, split, output, solver, petsc");
   top.check_all_used();
   // The resolved config, stored with the data: the preset merged in, paths made absolute, the
   // count of a directory family written out, and its files listed (in comments: the text is

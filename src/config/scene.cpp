@@ -9,35 +9,14 @@
 #include <sstream>
 
 #include "hypershape/core/error.hpp"
+#include "effects_block.hpp"
 #include "solver_block.hpp"
 #include "yaml_block.hpp"
 
 namespace hypershape::config {
 
-namespace {
-
 using core::InputError;
 
-class YamlEffectParams : public EffectParams {
- public:
-  YamlEffectParams(const YAML::Node& node, const std::string& file, const std::string& path)
-      : block_(node, file, path) {}
-  bool has(const std::string& key) const override { return block_.has(key); }
-  double number(const std::string& key) const override { return block_.number(key); }
-  std::vector<double> vector(const std::string& key, std::size_t n) const override {
-    return block_.vector(key, n);
-  }
-  std::string text(const std::string& key) const override { return block_.text(key); }
-  [[noreturn]] void fail(const std::string& key, const std::string& message) const override {
-    block_.fail(key, message);
-  }
-  void check_all_used() const override { block_.check_all_used(); }
-
- private:
-  YamlBlock block_;
-};
-
-}  // namespace
 
 const char* default_scene_text() {
   return R"(# The default scene: the seed paper's set-up (section 3.2, appendix A) on the unit disk.
@@ -109,13 +88,7 @@ Scene parse_scene_text(const std::string& text, const std::string& source, const
   mesh.check_all_used();
 
   if (!top.has("effects")) top.fail("effects", "missing (a mapping of effect names to parameters)");
-  YamlBlock eff(top.get("effects"), source, "effects");
-  for (const auto& kv : eff.node()) {
-    const std::string name = kv.first.Scalar();
-    eff.get(name);  // mark used; the registry checks the name when the effect is built
-    s.effects.emplace_back(name, std::make_shared<YamlEffectParams>(kv.second, source, "effects." + name));
-  }
-  if (s.effects.empty()) top.fail("effects", "must list at least one effect");
+  s.effects = parse_effects(YamlBlock(top.get("effects"), source, "effects"), false);
 
   YamlBlock load(top.get("load"), source, "load");
   if (!top.has("load")) top.fail("load", "missing (load: {target: 0.3} or load: {alpha: 10})");

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <thread>
 
+#include "hypershape/config/scene.hpp"
 #include "hypershape/core/collective.hpp"
 #include "hypershape/core/error.hpp"
 #include "hypershape/core/log.hpp"
@@ -206,6 +207,7 @@ RunReport generate(MPI_Comm comm, const config::DatasetConfig& cfg, const Genera
         io::ShardHeader h;
         h.dataset_name = cfg.name;
         h.config_text = cfg.text;
+        h.scene_text = config::effects_yaml(cfg.scene);
         h.config_hash = hash;
         h.seed = cfg.seed;
         h.dim = cfg.shapes.dim;

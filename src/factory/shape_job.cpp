@@ -2,11 +2,13 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <numeric>
 
 #include "hypershape/core/error.hpp"
+#include "hypershape/factory/dataset_schema.hpp"
 #include "hypershape/factory/load_cases.hpp"
 #include "hypershape/factory/shape_pipeline.hpp"
 #include "hypershape/factory/shape_set.hpp"
@@ -40,8 +42,7 @@ class Moments {
   }
   void store(std::vector<io::Array>& out) const {
     for (const auto& [name, m] : rows_)
-      out.push_back({"stats/" + name, {m.size() / 3, 3}, m,
-                     "per component: count, sum, sum of squares over this shape's converged values", ""});
+      out.push_back(schema_array("stats/" + name, {m.size() / 3, 3}, m));
   }
 
  private:
@@ -94,27 +95,133 @@ bool all_finite(const std::vector<double>& v) {
   return true;
 }
 
-}  // namespace
+/// The input channels the scene's effects bring (traction, body force, ...), per load case at
+/// the nodes ("loads/<name>", surface channels at the Neumann nodes only) and on the grid
+/// ("loads/grid_<name>"), each summed over its effects, a scaled effect times alpha. A channel
+/// no effect brings is neither allocated nor stored.
+class Channels {
+ public:
+  Channels(const physics::Problem& p, const config::RepresentationsConfig& rep) : rep_(rep) {
+    for (std::size_t i = 0; i < p.effects().size(); ++i) {
+      const std::string c = p.effects()[i]->channel();
+      if (c.empty()) continue;
+      auto it = std::find_if(channels_.begin(), channels_.end(), [&](const Channel& x) { return x.name == c; });
+      if (it == channels_.end()) it = channels_.insert(channels_.end(), Channel{c, {}, {}, {}});
+      it->effects.push_back(i);
+    }
+  }
+  void allocate(std::size_t node_values, std::size_t grid_values) {
+    for (auto& c : channels_) {
+      if (rep_.point_cloud) c.nodes.assign(node_values, 0.0);
+      if (rep_.grid) c.grid.assign(grid_values, 0.0f);
+    }
+  }
+  /// Load case L (group root).
+  void fill(const physics::Problem& p, std::size_t L, double alpha, int d, const std::vector<double>& nodes,
+            const std::vector<std::int8_t>& neumann, const std::vector<double>& grid, Moments& moments) {
+    const std::size_t n_nodes = nodes.size() / std::size_t(d), n_grid = grid.size() / std::size_t(d);
+    for (auto& c : channels_) {
+      if (rep_.point_cloud) {
+        double* v = c.nodes.data() + L * n_nodes * std::size_t(d);
+        add(p, c, alpha, d, nodes, &neumann, v);
+        moments.add(c.name, v, n_nodes * std::size_t(d), d);
+      }
+      if (rep_.grid) {
+        std::vector<double> g(n_grid * std::size_t(d), 0.0);
+        add(p, c, alpha, d, grid, nullptr, g.data());
+        std::copy(g.begin(), g.end(), c.grid.begin() + std::ptrdiff_t(L * g.size()));
+        moments.add("grid_" + c.name, g.data(), g.size(), d);
+      }
+    }
+  }
+  void store(std::vector<io::Array>& arrays, std::uint64_t n_loads, std::uint64_t n_nodes,
+             const std::vector<std::uint64_t>& grid_shape, std::uint64_t d) {
+    for (auto& c : channels_) {
+      if (rep_.point_cloud) {
+        arrays.push_back(schema_array("loads/" + c.name, {n_loads, n_nodes, d}, std::move(c.nodes)));
+      }
+      if (rep_.grid) {
+        std::vector<std::uint64_t> s{n_loads};
+        s.insert(s.end(), grid_shape.begin(), grid_shape.end());
+        s.push_back(d);
+        arrays.push_back(schema_array("loads/grid_" + c.name, s, std::move(c.grid)));
+      }
+    }
+  }
 
-ShapeProblem make_shape_problem(MPI_Comm group, const config::DatasetConfig& cfg,
-                                const ShapeSample& shape, const LoadCase& first,
-                                std::optional<physics::SpaceOptions> space) {
-  const int d = cfg.shapes.dim;
-  std::vector<physics::EffectPtr> effects;
-  effects.push_back(physics::make_neo_hookean(cfg.material.E, cfg.material.nu));
-  effects.push_back(physics::make_dirichlet_patch(
-      std::vector<double>(shape.dirichlet_center.begin(), shape.dirichlet_center.begin() + d),
-      shape.dirichlet_radius));
-  auto gt = std::make_unique<physics::GaussianTraction>(
-      std::vector<double>(first.center.begin(), first.center.begin() + d),
-      std::vector<double>(first.direction.begin(), first.direction.begin() + d), cfg.loads.gamma);
-  ShapeProblem out;
-  out.traction = gt.get();
-  effects.push_back(std::move(gt));
-  out.problem = std::make_unique<physics::Problem>(group, shape.mesh, std::move(effects),
-                                                   space.value_or(physics::SpaceOptions{cfg.degree}));
-  return out;
+ private:
+  struct Channel {
+    std::string name;
+    std::vector<std::size_t> effects;
+    std::vector<double> nodes;
+    std::vector<float> grid;
+  };
+  /// Adds the channel's value at `points` into v; `neumann` (nodes): surface channels there only.
+  static void add(const physics::Problem& p, const Channel& c, double alpha, int d, const std::vector<double>& points,
+                  const std::vector<std::int8_t>* neumann, double* v) {
+    const std::size_t n = points.size() / std::size_t(d);
+    for (std::size_t i : c.effects) {
+      const physics::Effect& e = *p.effects()[i];
+      if (!e.active()) continue;
+      const double scale = e.scaled() ? alpha : 1.0;
+      for (std::size_t a = 0; a < n; ++a) {
+        if (neumann && e.channel_on_boundary() && !(*neumann)[a]) continue;
+        double t[3] = {0, 0, 0};
+        e.channel_value(&points[a * std::size_t(d)], t);
+        for (int k = 0; k < d; ++k) v[a * std::size_t(d) + std::size_t(k)] += scale * t[k];
+      }
+    }
+  }
+  config::RepresentationsConfig rep_;
+  std::vector<Channel> channels_;
+};
+
+/// The scene's drawn parameters ("params/<label>/<key>": one value per shape, or one per load
+/// case) and the placements of tractions after the first ("params/gaussian_traction.k/center",
+/// ".../direction"; the first's are loads/p_n and loads/g).
+class DrawnParams {
+ public:
+  DrawnParams(const config::DatasetConfig& cfg, std::int64_t shape_id, int n_loads)
+      : cfg_(cfg), shape_id_(shape_id), n_loads_(n_loads) {}
+  void add(const LoadCase& lc) {
+    for (const auto& v : drawn_values(cfg_, shape_id_, lc.load_id))
+      if (v.per_load || lc.load_id == 0) values_[v.name].push_back(v.value);
+    const auto tractions = cfg_.scene.find("gaussian_traction");
+    for (std::size_t k = 0; k < lc.more_centers.size(); ++k) {
+      const auto& given = cfg_.scene.effects[tractions.at(k + 1)].params;  // a fixed one is in the scene
+      const std::string label = "gaussian_traction." + std::to_string(k + 1);
+      if (!given.count("center")) append(placements_[label + "/center"], lc.more_centers[k]);
+      if (!given.count("direction")) append(placements_[label + "/direction"], lc.more_directions[k]);
+    }
+  }
+  void store(std::vector<io::Array>& arrays) {
+    for (auto& [name, v] : values_) {
+      const auto n = std::uint64_t(v.size());  // before v is moved
+      arrays.push_back(schema_array("params/" + name, {n}, std::move(v)));
+    }
+    for (auto& [name, v] : placements_)
+      arrays.push_back(
+          schema_array("params/" + name, {std::uint64_t(n_loads_), std::uint64_t(cfg_.shapes.dim)}, std::move(v)));
+  }
+
+ private:
+  void append(std::vector<double>& to, const std::array<double, 3>& v) const {
+    to.insert(to.end(), v.begin(), v.begin() + cfg_.shapes.dim);
+  }
+  const config::DatasetConfig& cfg_;
+  std::int64_t shape_id_;
+  int n_loads_;
+  std::map<std::string, std::vector<double>> values_, placements_;
+};
+
+/// I_N of the scene's first Gaussian traction (0 if none).
+double first_normaliser(const physics::Problem& p) {
+  for (const auto& e : p.effects())
+    if (const auto* t = dynamic_cast<const physics::GaussianTraction*>(e.get())) return t->normaliser();
+  return 0.0;
 }
+
+}  // namespace
 
 ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
                          const std::optional<geometry::Boundary>& base, std::int64_t shape_id,
@@ -131,7 +238,7 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
   {
     auto t = out.times.scope("shape");
     try {
-      shape = make_shape(cfg.shapes, base, cfg.seed, shape_id);
+      shape = make_shape(shape_config(cfg, shape_id), base, cfg.seed, shape_id);
     } catch (const std::runtime_error& e) {
       out.entry.ok = false;
       out.entry.failure = e.what();
@@ -149,19 +256,17 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
   out.entry.shape = to_record(shape);
   for (auto it = out.entry.shape.numbers.begin(); it != out.entry.shape.numbers.end();)
     it = it->first.rfind("seconds_", 0) == 0 ? out.entry.shape.numbers.erase(it) : std::next(it);
-  const auto cases = draw_load_cases(shape, cfg.loads, cfg.seed);
+  const auto cases = draw_load_cases(shape, cfg.loads, cfg.seed, n_tractions(cfg));
 
   // ---- the problem, set up once for all load cases --------------------------------------------
-  std::unique_ptr<physics::Problem> problem;
+  ShapeProblem sp;
   std::unique_ptr<solver::NonlinearSolver> nl;
-  physics::GaussianTraction* traction = nullptr;
   {
     auto t = out.times.scope("setup");
-    ShapeProblem sp = make_shape_problem(group, cfg, shape, cases[0]);
-    problem = std::move(sp.problem);
-    traction = sp.traction;
-    nl = std::make_unique<solver::NonlinearSolver>(*problem, cfg.solver);
+    sp = make_shape_problem(group, cfg, shape, cases[0]);
+    nl = std::make_unique<solver::NonlinearSolver>(*sp.problem, cfg.solver);
   }
+  const physics::Problem* problem = sp.problem.get();
   const auto& space = problem->space();
   out.n_dofs = space.n_dofs_global();
 
@@ -183,14 +288,12 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
     cells = space.canonical_cells();
     n_nodes = std::int64_t(nodes.size()) / d;
     const auto per_cell = std::uint64_t(cells.size()) / std::uint64_t(shape.mesh.n_cells());
-    arrays.push_back({"nodes", {U64(n_nodes), U64(d)}, nodes,
-                      "finite-element nodes: mesh vertices first, then (P2) edge midpoints", "length"});
-    arrays.push_back({"cells", {U64(shape.mesh.n_cells()), per_cell}, cells,
-                      "cell-to-node connectivity, VTK order", ""});
+    arrays.push_back(schema_array("nodes", {U64(n_nodes), U64(d)}, nodes));
+    arrays.push_back(schema_array("cells", {U64(shape.mesh.n_cells()), per_cell}, cells));
     boundary_node_masks(shape.boundary, shape.dirichlet_facets, cells, cfg.degree, n_nodes, dirichlet_mask,
                         neumann_mask);
-    arrays.push_back({"dirichlet_mask", {U64(n_nodes)}, dirichlet_mask, "1 on the Dirichlet patch (u = 0)", ""});
-    arrays.push_back({"neumann_mask", {U64(n_nodes)}, neumann_mask, "1 on the Neumann boundary (traction)", ""});
+    arrays.push_back(schema_array("dirichlet_mask", {U64(n_nodes)}, dirichlet_mask));
+    arrays.push_back(schema_array("neumann_mask", {U64(n_nodes)}, neumann_mask));
     const geometry::SignedDistance sdf(shape.boundary);
     std::vector<std::int64_t> dfacets(shape.dirichlet_facets.begin(), shape.dirichlet_facets.end());
     const geometry::FacetSetDistance ddist(shape.boundary, dfacets);
@@ -200,10 +303,8 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
       ddist.evaluate(nodes, dd);
       moments.add("sdf", s.data(), s.size(), 1);
       moments.add("dirichlet_distance", dd.data(), dd.size(), 1);
-      arrays.push_back({"point_cloud/sdf", {U64(n_nodes)}, std::move(s),
-                        "signed distance to the boundary at the nodes (negative inside)", "length"});
-      arrays.push_back({"point_cloud/dirichlet_distance", {U64(n_nodes)}, std::move(dd),
-                        "distance to the Dirichlet patch at the nodes", "length"});
+      arrays.push_back(schema_array("point_cloud/sdf", {U64(n_nodes)}, std::move(s)));
+      arrays.push_back(schema_array("point_cloud/dirichlet_distance", {U64(n_nodes)}, std::move(dd)));
     }
     if (cfg.representations.grid) {
       grid = sampling::grid_points(d, N);
@@ -214,16 +315,11 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
       ddist.evaluate(grid, dd);
       moments.add("grid_sdf", s.data(), s.size(), 1);
       moments.add("grid_dirichlet_distance", dd.data(), dd.size(), 1);
-      arrays.push_back({"grid/sdf", grid_shape, to_float(s),
-                        "signed distance on the grid over [-1, 1]^d (negative inside), numpy 'ij' order",
-                        "length"});
-      arrays.push_back({"grid/dirichlet_distance", grid_shape, to_float(dd),
-                        "distance to the Dirichlet patch on the grid (0 on the patch, never negative)",
-                        "length"});
+      arrays.push_back(schema_array("grid/sdf", grid_shape, to_float(s)));
+      arrays.push_back(schema_array("grid/dirichlet_distance", grid_shape, to_float(dd)));
       sampler = std::make_unique<sampling::MeshSampler>(d, cfg.degree, nodes, cells, shape.boundary, sdf, grid);
       const auto inside = sampler->inside();
-      arrays.push_back({"grid/inside", grid_shape, std::vector<std::int8_t>(inside.begin(), inside.end()),
-                        "1 where the grid point is in the body", ""});
+      arrays.push_back(schema_array("grid/inside", grid_shape, std::vector<std::int8_t>(inside.begin(), inside.end())));
     }
   }
 
@@ -235,15 +331,14 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
       g(std::size_t(n_loads * d));
   std::vector<std::int64_t> newton(std::size_t(n_loads), 0), solves(std::size_t(n_loads), 0),
       failed_inc(std::size_t(n_loads), 0), recovery(std::size_t(n_loads), 0);
-  std::vector<double> displacement, node_traction;
-  std::vector<float> grid_u, grid_t;
+  std::vector<double> displacement;
+  std::vector<float> grid_u;
+  Channels channels(*problem, cfg.representations);
+  DrawnParams drawn(cfg, shape_id, n_loads);
   if (root) {
     displacement.assign(std::size_t(n_loads * n_nodes * d), 0.0);
-    if (cfg.representations.point_cloud) node_traction.assign(displacement.size(), 0.0);
-    if (cfg.representations.grid) {
-      grid_u.assign(std::size_t(n_loads) * n_grid * std::size_t(d), 0.0f);
-      grid_t.assign(grid_u.size(), 0.0f);
-    }
+    if (cfg.representations.grid) grid_u.assign(std::size_t(n_loads) * n_grid * std::size_t(d), 0.0f);
+    channels.allocate(displacement.size(), std::size_t(n_loads) * n_grid * std::size_t(d));
   }
   for (int l = 0; l < n_loads; ++l) {
     const LoadCase& lc = cases[std::size_t(l)];
@@ -253,16 +348,15 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
       p_n[L * std::size_t(d) + std::size_t(k)] = lc.center[std::size_t(k)];
       g[L * std::size_t(d) + std::size_t(k)] = lc.direction[std::size_t(k)];
     }
+    drawn.add(lc);  // before anything that may fail: one row per load case
     solver::TargetResult r;
     std::string failure;
     try {
-      traction->set(std::vector<double>(lc.center.begin(), lc.center.begin() + d),
-                    std::vector<double>(lc.direction.begin(), lc.direction.begin() + d));
       {
         auto t = out.times.scope("setup");
-        problem->reassemble_load();
+        sp.set_load_case(cfg, shape, lc);
       }
-      normaliser[L] = traction->normaliser();
+      normaliser[L] = first_normaliser(*problem);
       nl->reset();
       r = nl->solve_for_target(lc.target);
       out.times.add("solve", r.seconds_first_solve);
@@ -305,28 +399,13 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
     const std::size_t off = L * std::size_t(n_nodes * d);
     std::copy(u.values.begin(), u.values.end(), displacement.begin() + std::ptrdiff_t(off));
     moments.add("displacement", u.values.data(), u.values.size(), d);
-    if (cfg.representations.point_cloud) {
-      for (std::int64_t n = 0; n < n_nodes; ++n) {
-        if (!neumann_mask[std::size_t(n)]) continue;
-        double tv[3];
-        traction->value(&nodes[std::size_t(n * d)], tv);
-        for (int k = 0; k < d; ++k) node_traction[off + std::size_t(n * d + k)] = alpha[L] * tv[k];
-      }
-      moments.add("traction", node_traction.data() + off, std::size_t(n_nodes * d), d);
-    }
+    channels.fill(*problem, L, alpha[L], d, nodes, neumann_mask, grid, moments);
     if (cfg.representations.grid) {
       const std::size_t goff = L * n_grid * std::size_t(d);
-      std::vector<double> gu(n_grid * std::size_t(d)), gt(n_grid * std::size_t(d));
+      std::vector<double> gu(n_grid * std::size_t(d));
       sampler->interpolate(u.values, d, gu);
-      for (std::size_t p = 0; p < n_grid; ++p) {
-        double tv[3];
-        traction->value(&grid[p * std::size_t(d)], tv);
-        for (int k = 0; k < d; ++k) gt[p * std::size_t(d) + std::size_t(k)] = alpha[L] * tv[k];
-      }
       std::copy(gu.begin(), gu.end(), grid_u.begin() + std::ptrdiff_t(goff));
-      std::copy(gt.begin(), gt.end(), grid_t.begin() + std::ptrdiff_t(goff));
       moments.add("grid_displacement", gu.data(), gu.size(), d);
-      moments.add("grid_traction", gt.data(), gt.size(), d);
     }
     moments.add("alpha", &alpha[L], 1, 1);
   }
@@ -334,34 +413,31 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
   if (root) {
     auto t = out.times.scope("representations");
     const U64 nl_ = U64(n_loads), du = U64(d);
-    arrays.push_back({"loads/status", {nl_}, status, "1 converged (target reached), 0 failed (see loads/reason)", ""});
-    arrays.push_back({"loads/alpha", {nl_}, alpha, "traction scale alpha = the total applied force |int t dS| (0 if failed)", "force"});
-    arrays.push_back({"loads/target", {nl_}, target, "wanted max|u|", "length"});
-    arrays.push_back({"loads/max_displacement", {nl_}, max_u, "achieved max over the nodes of |u| (0 if failed)", "length"});
-    arrays.push_back({"loads/min_det_f", {nl_}, min_det, "min det F over the quadrature points (0 if failed)", ""});
-    arrays.push_back({"loads/traction_normaliser", {nl_}, normaliser, "I_N = int_{Gamma_N} phi dS", "length^(d-1)"});
-    arrays.push_back({"loads/newton_iterations", {nl_}, newton, "Newton iterations, all solves of the alpha search", ""});
-    arrays.push_back({"loads/solves", {nl_}, solves, "nonlinear solves (alpha evaluations)", ""});
-    arrays.push_back({"loads/failed_increments", {nl_}, failed_inc, "load increments that failed and were halved", ""});
-    arrays.push_back({"loads/recovery_iterations", {nl_}, recovery,
-                      "Newton iterations spent in failed (discarded) increments: the cost of recovery", ""});
-    arrays.push_back({"loads/p_n", {nl_, du}, p_n, "traction centre p_N (on the Neumann boundary)", "length"});
-    arrays.push_back({"loads/g", {nl_, du}, g, "traction direction g (unit vector)", ""});
-    arrays.push_back({"loads/displacement", {nl_, U64(n_nodes), du}, std::move(displacement),
-                      "displacement u at the nodes (zero if failed)", "length"});
-    if (cfg.representations.point_cloud)
-      arrays.push_back({"loads/traction", {nl_, U64(n_nodes), du}, std::move(node_traction),
-                        "traction t = alpha g phi / I_N at the Neumann nodes, zero elsewhere", "force/length^(d-1)"});
+    const bool has_traction = n_tractions(cfg) > 0;
+    arrays.push_back(schema_array("loads/status", {nl_}, status));
+    arrays.push_back(schema_array("loads/alpha", {nl_}, alpha));
+    arrays.push_back(schema_array("loads/target", {nl_}, target));
+    arrays.push_back(schema_array("loads/max_displacement", {nl_}, max_u));
+    arrays.push_back(schema_array("loads/min_det_f", {nl_}, min_det));
+    if (has_traction)
+      arrays.push_back(schema_array("loads/traction_normaliser", {nl_}, normaliser));
+    arrays.push_back(schema_array("loads/newton_iterations", {nl_}, newton));
+    arrays.push_back(schema_array("loads/solves", {nl_}, solves));
+    arrays.push_back(schema_array("loads/failed_increments", {nl_}, failed_inc));
+    arrays.push_back(schema_array("loads/recovery_iterations", {nl_}, recovery));
+    if (has_traction) {
+      arrays.push_back(schema_array("loads/p_n", {nl_, du}, p_n));
+      arrays.push_back(schema_array("loads/g", {nl_, du}, g));
+    }
+    arrays.push_back(schema_array("loads/displacement", {nl_, U64(n_nodes), du}, std::move(displacement)));
     if (cfg.representations.grid) {
       std::vector<U64> s{nl_};
       s.insert(s.end(), grid_shape.begin(), grid_shape.end());
       s.push_back(du);
-      arrays.push_back({"loads/grid_displacement", s, std::move(grid_u),
-                        "displacement on the grid: FE interpolant inside, closest-boundary-point value outside",
-                        "length"});
-      arrays.push_back({"loads/grid_traction", s, std::move(grid_t),
-                        "traction field alpha g phi(x - p_N) / I_N on the whole grid", "force/length^(d-1)"});
+      arrays.push_back(schema_array("loads/grid_displacement", s, std::move(grid_u)));
     }
+    channels.store(arrays, nl_, U64(n_nodes), grid_shape, du);
+    drawn.store(arrays);
     moments.store(arrays);
     out.entry.load_reasons = std::move(reasons);
   }

@@ -9,6 +9,7 @@
 #include "hypershape/core/input_error.hpp"
 #include "hypershape/core/log.hpp"
 #include "hypershape/core/petsc_handle.hpp"
+#include "hypershape/factory/dataset_scene.hpp"
 
 namespace hypershape::factory {
 
@@ -168,7 +169,7 @@ std::vector<io::ShapeRecord> make_shape_range(MPI_Comm comm, const config::Datas
   for (std::int64_t id = first + rank; id < first + count; id += size) {
     io::ShapeRecord r;
     try {
-      const ShapeSample s = make_shape(config.shapes, base, config.seed, id);
+      const ShapeSample s = make_shape(shape_config(config, id), base, config.seed, id);
       r = to_record(s);
       core::log_line(MPI_COMM_SELF, core::Verbosity::normal,
                      fmt::format("[rank {}] shape {}: {} boundary facets, {} vertices, {} cells, "

@@ -10,7 +10,7 @@
 #include "hypershape/core/error.hpp"
 #include "hypershape/mesh/gmsh_mesher.hpp"
 #include "hypershape/physics/problem.hpp"
-#include "hypershape/physics/registry.hpp"
+#include "hypershape/physics/scene.hpp"
 #include "hypershape/solver/nonlinear.hpp"
 
 namespace hypershape::factory {
@@ -18,13 +18,13 @@ namespace hypershape::factory {
 namespace {
 
 /// The clamp the mesher must conform to: the scene's dirichlet_patch, if any.
-std::optional<mesh::ClampRegion> clamp_of(const config::Scene& s) {
-  for (auto& [name, p] : s.effects)
-    if (name == "dirichlet_patch") {
+std::optional<mesh::ClampRegion> clamp_of(const std::vector<physics::ResolvedEffect>& effects, int dim) {
+  for (const auto& e : effects)
+    if (e.name == "dirichlet_patch") {
       mesh::ClampRegion c;
-      auto v = p->vector("center", std::size_t(s.dim));
+      auto v = e.params.vector("center", std::size_t(dim));
       std::copy(v.begin(), v.end(), c.center.begin());
-      c.radius = p->number("radius");
+      c.radius = e.params.number("radius");
       return c;
     }
   return std::nullopt;
@@ -46,20 +46,12 @@ SceneOutcome solve_scene(MPI_Comm comm, const config::Scene& scene_in, const Sce
       scene.dim = d;
     }
   }
-  // Build (and so validate) every effect before any mesh or solver work.
-  std::vector<physics::EffectPtr> effects;
-  bool has_energy = false, has_dirichlet = false;
-  for (auto& [name, params] : scene.effects) {
-    effects.push_back(physics::make_effect(name, *params, scene.dim));
-    params->check_all_used();
-    has_energy = has_energy || effects.back()->has_energy();
-    has_dirichlet = has_dirichlet || name.find("dirichlet") != std::string::npos;
-  }
-  if (!has_energy)
-    throw core::InputError(scene.source, "effects", "no material: add one, e.g. neo_hookean: {E: 500, nu: 0.49}");
-  if (!has_dirichlet)
-    throw core::InputError(scene.source, "effects",
-                           "no Dirichlet condition (e.g. dirichlet_patch): the problem would be singular");
+  // A scene file holds numbers only (config::parse_scene_text rejects distributions).
+  const auto resolved = physics::resolve(scene.effects, [](std::size_t, const std::string&, const physics::Draw& d) {
+    return d.low();
+  });
+  // Validate every effect before any mesh or solver work (build_problem builds them again).
+  (void)physics::build_effects(scene.source, resolved, scene.dim, bool(scene.target));
   solver::set_default_options(scene.petsc);
   {
     auto t = o.times.scope("mesh");
@@ -67,7 +59,7 @@ SceneOutcome solve_scene(MPI_Comm comm, const config::Scene& scene_in, const Sce
       mesh::MeshOptions mo;
       mo.h = scene.h;
       mo.clamp_size = scene.h * scene.clamp_refinement;
-      auto clamp = clamp_of(scene);
+      auto clamp = clamp_of(resolved, scene.dim);
       core::on_root(comm, [&] { m = scene.dim == 2 ? mesh::mesh_disk(mo, clamp) : mesh::mesh_ball(mo, clamp); });
     }
   }
@@ -76,7 +68,8 @@ SceneOutcome solve_scene(MPI_Comm comm, const config::Scene& scene_in, const Sce
   {
     auto t = o.times.scope("setup");
     try {
-      problem = std::make_unique<physics::Problem>(comm, m, std::move(effects), physics::SpaceOptions{scene.degree});
+      problem = physics::build_problem(comm, m, scene.source, resolved, scene.dim,
+                                       physics::SpaceOptions{scene.degree}, bool(scene.target));
     } catch (core::InputError& e) {
       throw core::InputError(scene.source, "", e.what());
     }

@@ -119,6 +119,20 @@ struct ShardWriter::Impl {
   bool committed = false;
 };
 
+namespace {
+
+/// A scalar string dataset (the config, the scene).
+void write_text(hid_t f, const char* name, const std::string& text) {
+  Id dcpl = untimed(H5P_DATASET_CREATE);
+  Id type{check_id(H5Tcopy(H5T_C_S1), name), H5Tclose};
+  check(H5Tset_size(type.id, std::max<std::size_t>(1, text.size())), name);
+  Id space{check_id(H5Screate(H5S_SCALAR), name), H5Sclose};
+  Id ds{check_id(H5Dcreate2(f, name, type.id, space.id, H5P_DEFAULT, dcpl.id, H5P_DEFAULT), name), H5Dclose};
+  check(H5Dwrite(ds.id, type.id, H5S_ALL, H5S_ALL, H5P_DEFAULT, text.empty() ? " " : text.c_str()), name);
+}
+
+}  // namespace
+
 ShardWriter::ShardWriter(std::string path, const ShardHeader& h) : impl_(std::make_unique<Impl>()) {
   impl_->path = std::move(path);
   impl_->tmp = impl_->path + ".tmp";
@@ -146,14 +160,8 @@ ShardWriter::ShardWriter(std::string path, const ShardHeader& h) : impl_(std::ma
     software["hdf5"] = hdf5_version();
     for (const auto& [k, v] : software) attr_string(sw.id, k, v);
   }
-  {
-    Id dcpl = untimed(H5P_DATASET_CREATE);
-    Id type{check_id(H5Tcopy(H5T_C_S1), "config"), H5Tclose};
-    check(H5Tset_size(type.id, std::max<std::size_t>(1, h.config_text.size())), "config");
-    Id space{check_id(H5Screate(H5S_SCALAR), "config"), H5Sclose};
-    Id ds{check_id(H5Dcreate2(f, "config", type.id, space.id, H5P_DEFAULT, dcpl.id, H5P_DEFAULT), "config"), H5Dclose};
-    check(H5Dwrite(ds.id, type.id, H5S_ALL, H5S_ALL, H5P_DEFAULT, h.config_text.empty() ? " " : h.config_text.c_str()), "config");
-  }
+  write_text(f, "config", h.config_text);
+  if (!h.scene_text.empty()) write_text(f, "scene", h.scene_text);
   Id shapes = make_group(f, "shapes");
   impl_->shapes = shapes.id;
   shapes.id = -1;  // owned by the writer now

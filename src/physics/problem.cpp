@@ -3,6 +3,8 @@
 #include <petscdmplex.h>
 #include <petscsnes.h>
 
+#include <algorithm>
+#include <cassert>
 #include <cmath>
 
 #include "hypershape/core/error.hpp"
@@ -87,20 +89,36 @@ Problem::Problem(MPI_Comm comm, const mesh::MeshData& mesh, std::vector<EffectPt
   assemble_load();
 }
 
-void Problem::assemble_load() {
-  HS_PETSC(VecZeroEntries(load_));
+void Problem::assemble_loads(bool scaled, Vec f) const {
+  HS_PETSC(VecZeroEntries(f));
   LocalArray fl(dm(), true);
   for (auto& e : effects_)
-    if (e->has_load()) e->add_load(*space_, fl.array());
+    if (e->has_load() && e->active() && e->scaled() == scaled) e->add_load(*space_, fl.array());
   fl.release();
-  HS_PETSC(DMLocalToGlobal(dm(), fl.vec(), ADD_VALUES, load_));
+  HS_PETSC(DMLocalToGlobal(dm(), fl.vec(), ADD_VALUES, f));
+}
+
+void Problem::assemble_load() {
+  assemble_loads(true, load_);
   HS_PETSC(VecNorm(load_, NORM_2, &load_norm_));
+  // A fixed load is allocated and assembled only when some effect has one.
+  const bool any_fixed = std::any_of(effects_.begin(), effects_.end(),
+                                     [](const EffectPtr& e) { return e->has_load() && !e->scaled(); });
+  if (!any_fixed) return;
+  if (!fixed_load_) HS_PETSC(DMCreateGlobalVector(dm(), fixed_load_.out()));
+  assemble_loads(false, fixed_load_);
 }
 
 void Problem::reassemble_load() {
   for (auto& e : effects_)
     if (e->has_load()) e->setup(*space_);
   assemble_load();
+}
+
+void Problem::replace_load(std::size_t index, EffectPtr effect) {
+  assert(index < effects_.size() && effects_[index]->has_load() && !effects_[index]->has_energy() &&
+         effects_[index]->essential_bcs().empty() && effect->has_load());
+  effects_[index] = std::move(effect);
 }
 
 void Problem::to_local(Vec u, Vec ul) const {
@@ -120,9 +138,10 @@ bool Problem::energy(Vec u, double load_factor, double& value) const {
     if (eff->has_energy()) ok = ok && eff->add_energy(*space_, ul.array(), e);
   ok = all_ranks(comm(), ok);
   MPI_Allreduce(MPI_IN_PLACE, &e, 1, MPI_DOUBLE, MPI_SUM, comm());
-  PetscScalar work;
+  PetscScalar work, fixed = 0;
   HS_PETSC(VecDot(load_, u, &work));
-  value = ok ? e - load_factor * PetscRealPart(work) : INFINITY;
+  if (fixed_load_) HS_PETSC(VecDot(fixed_load_, u, &fixed));
+  value = ok ? e - load_factor * PetscRealPart(work) - PetscRealPart(fixed) : INFINITY;
   return ok;
 }
 
@@ -137,6 +156,7 @@ bool Problem::residual(Vec u, double load_factor, Vec r) const {
   HS_PETSC(VecZeroEntries(r));
   HS_PETSC(DMLocalToGlobal(dm(), rl.vec(), ADD_VALUES, r));
   if (load_factor != 0.0) HS_PETSC(VecAXPY(r, -load_factor, load_));
+  if (fixed_load_) HS_PETSC(VecAXPY(r, -1.0, fixed_load_));
   return ok;
 }
 
@@ -176,12 +196,12 @@ void Problem::jacobian_pointwise(Vec u, Mat J) const {
 
 Resultants Problem::resultants(Vec u, double load_factor) const {
   const int dim = space_->dim();
-  LocalArray ul(dm(), false), fi(dm(), true), fe(dm(), true);
+  LocalArray ul(dm(), false), fi(dm(), true), fe(dm(), true), ff(dm(), true);
   to_local(u, ul.vec());
   bool ok = true;
   for (auto& eff : effects_) {
     if (eff->has_energy()) ok = ok && eff->add_residual(*space_, ul.array(), fi.array());
-    if (eff->has_load()) eff->add_load(*space_, fe.array());
+    if (eff->has_load() && eff->active()) eff->add_load(*space_, eff->scaled() ? fe.array() : ff.array());
   }
   Resultants out;
   out.admissible = all_ranks(comm(), ok);
@@ -195,7 +215,7 @@ Resultants Problem::resultants(Vec u, double load_factor) const {
   HS_PETSC(DMGetCoordinateSection(dm(), &cs));
   HS_PETSC(DMGetCoordinatesLocal(dm(), &coords));
   HS_PETSC(VecGetArrayRead(coords, &xa));
-  const PetscScalar *a = ul.array(), *f_int = fi.array(), *f_ext = fe.array();
+  const PetscScalar *a = ul.array(), *f_int = fi.array(), *f_ext = fe.array(), *f_fix = ff.array();
   PetscInt p0, p1;
   HS_PETSC(PetscSectionGetChart(ls, &p0, &p1));
   for (PetscInt p = p0; p < p1; ++p) {
@@ -208,7 +228,7 @@ Resultants Problem::resultants(Vec u, double load_factor) const {
     double y[3] = {0, 0, 0}, load[3] = {0, 0, 0}, support[3] = {0, 0, 0};
     for (int i = 0; i < dim; ++i) {
       y[i] = x[i] + PetscRealPart(a[off + i]);
-      load[i] = load_factor * PetscRealPart(f_ext[off + i]);
+      load[i] = load_factor * PetscRealPart(f_ext[off + i]) + PetscRealPart(f_fix[off + i]);
       out.applied_force[i] += load[i];
     }
     add_moment(y, load, out.applied_moment);

@@ -28,6 +28,17 @@
 ///   gamma: 0.2                    # traction width (paper: 0.2 in 2D, 0.1 in 3D)
 ///   target: [0.1, 0.5]            # max|u| range, covered by stratified sampling
 /// material: {E: 500, nu: 0.49}    # compressible Neo-Hookean (appendix A)
+///                                 # material, loads.gamma and shapes.dirichlet_radius are
+///                                 # shorthands of this scene (the paper's three effects):
+/// effects:                        # optional, instead of the shorthands: a scene's effects
+///   neo_hookean: {E: {uniform: [400, 600], sample: shape}, nu: 0.49}
+///   dirichlet_patch: {radius: 0.5}          # centre drawn on each shape's boundary
+///   gaussian_traction:                      # a list: several tractions per load case, each
+///     - {gamma: 0.2}                        # centre and direction drawn per load case
+///     - {gamma: {choice: [0.1, 0.2], sample: load}}
+///   body_force: {value: [0, -0.5], scale: fixed}   # not scaled by the tuned alpha
+///   # or a drawn number of copies of a load: gaussian_traction: {gamma: 0.2,
+///   #   count: {choice: [1, 2, 3], sample: load}}  (copy k acts where k < the count)
 /// mesh: {degree: 1}               # P1 | P2; h: 3D only, optional: the mesh's edge length when
 ///                                 # coarser than shapes.h (the shape is drawn at shapes.h, its
 ///                                 # surface remeshed at h; see factory::ShapeConfig::mesh_h)
@@ -48,6 +59,7 @@
 #include <vector>
 
 #include "hypershape/factory/shape_pipeline.hpp"
+#include "hypershape/physics/scene.hpp"
 #include "hypershape/solver/nonlinear.hpp"
 
 namespace hypershape::config {
@@ -83,7 +95,11 @@ struct DatasetConfig {
   std::int64_t n_shapes = 0;
   factory::ShapeConfig shapes;
   LoadsConfig loads;
-  MaterialConfig material;
+  MaterialConfig material;  ///< the shorthand (also set from a fixed neo_hookean of `scene`)
+  /// What is solved: the config's effects, or the scene the shorthands stand for. The factory
+  /// draws dirichlet_patch.center per shape and gaussian_traction center/direction per load case.
+  physics::SceneSpec scene;
+  bool scene_given = false;  ///< `effects:` was written (else: the shorthands)
   int degree = 1;
   RepresentationsConfig representations;
   SplitConfig split;

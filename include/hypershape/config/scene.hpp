@@ -4,8 +4,9 @@
 /// ```yaml
 /// geometry: {base: circle}            # circle (2D) | sphere (3D) | file (+ file: PATH.msh)
 /// mesh: {h: 0.05, degree: 1, clamp_refinement: 0.25}
-/// effects:
-///   neo_hookean: {E: 500, nu: 0.49}
+/// effects:                           # a list for an effect that appears several times:
+///   neo_hookean: {E: 500, nu: 0.49}   #   gaussian_traction: [{...}, {...}]
+///                                     # loads take scale: alpha (default) | fixed
 ///   dirichlet_patch: {center: [1, 0], radius: 0.5}
 ///   gaussian_traction: {center: [-1, 0], direction: [0, 1], gamma: 0.2}
 /// load: {target: 0.3}                 # or {alpha: 10}
@@ -21,18 +22,11 @@
 #include <vector>
 
 #include "hypershape/core/params.hpp"
+#include "hypershape/physics/scene.hpp"
 #include "hypershape/physics/space.hpp"
 #include "hypershape/solver/nonlinear.hpp"
 
 namespace hypershape::config {
-
-/// A block of effect parameters that remembers which keys were read.
-class EffectParams : public core::Params {
- public:
-  virtual ~EffectParams() = default;
-  /// Throws InputError for any key that was never read (an unknown key).
-  virtual void check_all_used() const = 0;
-};
 
 struct Scene {
   std::string source;      ///< file name, or "<default scene>"
@@ -43,7 +37,7 @@ struct Scene {
   double h = 0.05;
   int degree = 1;
   double clamp_refinement = 0.25;
-  std::vector<std::pair<std::string, std::shared_ptr<EffectParams>>> effects;  ///< in file order
+  physics::SceneSpec effects;  ///< in file order; numbers only (no draws in a scene file)
   std::optional<double> alpha, target;
   solver::SolverOptions solver;
   std::vector<std::pair<std::string, std::string>> petsc;  ///< option (with dash), value
@@ -53,6 +47,10 @@ struct Scene {
 /// the effects are built). Throws core::InputError.
 Scene parse_scene_file(const std::string& path);
 Scene parse_scene_text(const std::string& text, const std::string& source, const std::string& base_dir = ".");
+/// The effects of a scene as a YAML `effects:` mapping (lists for repeated effects, draws as
+/// written): stored with the data of a dataset (shard attribute "scene").
+std::string effects_yaml(const physics::SceneSpec& spec);
+
 /// The embedded default scene: the seed paper's set-up on the unit disk.
 const char* default_scene_text();
 

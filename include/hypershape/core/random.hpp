@@ -24,6 +24,7 @@ enum class Purpose : std::uint64_t {
   traction = 3,    ///< traction centre p_N and direction g
   target = 4,      ///< target displacement magnitude of a load case
   split = 5,       ///< train/val/test assignment of shapes
+  parameter = 6,   ///< a scene parameter drawn from a distribution (per shape or load case)
   test = 99,       ///< tests and benchmarks
 };
 

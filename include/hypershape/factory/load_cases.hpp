@@ -18,11 +18,14 @@ struct LoadCase {
   std::array<double, 3> center{};     ///< p_N, on the Neumann boundary
   std::array<double, 3> direction{};  ///< g, |g| = 1
   double target = 0;                  ///< wanted max|u|
+  /// Further tractions of the scene (gaussian_traction 1, 2, ...): centre and direction drawn
+  /// like the first, from the stream (seed, traction, {shape id, load id, k}).
+  std::vector<std::array<double, 3>> more_centers, more_directions;
 };
 
-/// All `loads.count` load cases of `shape`. Throws std::invalid_argument if the shape has no
-/// Neumann boundary.
+/// All `loads.count` load cases of `shape`, each with `n_tractions` traction placements.
+/// Throws std::invalid_argument if the shape has no Neumann boundary.
 std::vector<LoadCase> draw_load_cases(const ShapeSample& shape, const config::LoadsConfig& loads,
-                                      std::uint64_t seed);
+                                      std::uint64_t seed, int n_tractions = 1);
 
 }  // namespace hypershape::factory

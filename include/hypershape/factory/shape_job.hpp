@@ -12,11 +12,11 @@
 
 #include "hypershape/config/dataset.hpp"
 #include "hypershape/core/timer.hpp"
+#include "hypershape/factory/dataset_scene.hpp"
 #include "hypershape/factory/load_cases.hpp"
 #include "hypershape/factory/shape_pipeline.hpp"
 #include "hypershape/geometry/boundary.hpp"
 #include "hypershape/io/dataset_shard.hpp"
-#include "hypershape/physics/gaussian_traction.hpp"
 #include "hypershape/physics/problem.hpp"
 #include "hypershape/solver/tangent.hpp"
 
@@ -32,17 +32,6 @@ struct ShapeJobResult {
   /// case), alpha_search (the further solves), representations, gather.
   core::PhaseTimes times;
 };
-
-/// The dataset's problem on one shape: Neo-Hookean material, the shape's Dirichlet patch and
-/// a Gaussian traction (set to `first`; traction->set() moves it to other load cases).
-struct ShapeProblem {
-  std::unique_ptr<physics::Problem> problem;
-  physics::GaussianTraction* traction = nullptr;  ///< owned by `problem`
-};
-/// Collective over `group`. `space`: the discretisation (default: the config's degree).
-ShapeProblem make_shape_problem(MPI_Comm group, const config::DatasetConfig& config,
-                                const ShapeSample& shape, const LoadCase& first,
-                                std::optional<physics::SpaceOptions> space = std::nullopt);
 
 /// Collective over `group`. `base` is load_base(config.shapes). `on_load(converged)` runs on
 /// every rank of the group after each load case (progress). Never throws for a shape or a

@@ -40,6 +40,7 @@ struct ShardShape {
 struct ShardHeader {
   std::string dataset_name;
   std::string config_text;    ///< the resolved config
+  std::string scene_text;     ///< the effects solved (YAML, draws as written), dataset "scene"
   std::string config_hash;    ///< hex digest of config_text: shards of one dataset agree
   std::uint64_t seed = 0;
   int dim = 2;

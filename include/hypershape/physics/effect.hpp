@@ -3,8 +3,9 @@
 /// only those are assembled. An effect may
 ///   - mark boundary facets and impose homogeneous essential conditions on them (Dirichlet),
 ///   - contribute a stored energy with its residual and tangent (a material),
-///   - contribute a dead load, a fixed external force vector scaled by the load factor
-///     (tractions, body forces).
+///   - contribute a dead load, a fixed external force vector (tractions, body forces), either
+///     scaled by the problem's load factor (the default: alpha, tuned to a target max|u|) or
+///     applied as it is (set_scaled(false): e.g. gravity under a tuned traction).
 /// A new effect is one file that implements this interface plus one line in registry.cpp.
 #include <petscdm.h>
 #include <petscds.h>
@@ -55,6 +56,26 @@ class Effect {
   virtual bool has_load() const { return false; }
   /// Adds the nominal external force into the local-vector array `f`. Not collective.
   virtual void add_load(const Space&, PetscScalar* /*f*/) const {}
+
+  // ---- input channels (what a dataset stores of the effect) ----------------------------------
+  /// The model-input field the effect brings ("traction", "body_force"), "" for none. A dataset
+  /// stores each channel at the nodes and on the grid; effects of one channel are summed.
+  virtual std::string channel() const { return ""; }
+  /// True for a surface field: stored at the Neumann boundary nodes only (zero elsewhere).
+  virtual bool channel_on_boundary() const { return false; }
+  /// The field at x for load factor 1 (`dim` components). Valid after setup(). Not collective.
+  virtual void channel_value(const double* /*x*/, double* /*value*/) const {}
+
+  /// Whether the load factor scales this effect's load (f_ext) or it is fixed (f_fixed).
+  bool scaled() const { return scaled_; }
+  void set_scaled(bool scaled) { scaled_ = scaled; }
+  /// An inactive load contributes nothing (a copy beyond the count drawn for this load case).
+  bool active() const { return active_; }
+  void set_active(bool active) { active_ = active; }
+
+ private:
+  bool scaled_ = true;
+  bool active_ = true;
 };
 
 using EffectPtr = std::unique_ptr<Effect>;

@@ -19,6 +19,9 @@ class GaussianTraction : public Effect {
   void setup(const Space& space) override;
   bool has_load() const override { return true; }
   void add_load(const Space& space, PetscScalar* f) const override;
+  std::string channel() const override { return "traction"; }
+  bool channel_on_boundary() const override { return true; }
+  void channel_value(const double* x, double* t) const override { value(x, t); }
 
   /// Moves the traction; call setup() again (Problem::reassemble_load does) before use.
   void set(std::vector<double> center, std::vector<double> direction);

@@ -1,7 +1,9 @@
 #pragma once
 /// A problem = a mesh, a discrete space and the effects of a scene. Assembles, on global
-/// vectors, R(u) = f_int(u) - s f_ext (s: the load factor, alpha for the Gaussian traction),
-/// its tangent, and the potential energy Pi(u) = int W(F) - s f_ext . u.
+/// vectors, R(u) = f_int(u) - s f_ext - f_fixed (s: the load factor, alpha for the Gaussian
+/// traction; f_fixed: the loads of effects that are not scaled, e.g. gravity under a tuned
+/// traction, assembled only when a scene has one), its tangent, and the potential energy
+/// Pi(u) = int W(F) - (s f_ext + f_fixed) . u.
 #include <array>
 #include <memory>
 #include <vector>
@@ -38,7 +40,7 @@ struct Resultants {
   bool admissible = true;                   ///< false if det F <= 0 somewhere (then garbage)
   std::array<double, 3> reaction_force{};   ///< exerted on the body by the essential conditions
   std::array<double, 3> reaction_moment{};  ///< sum over constrained dofs of (x + u) x force
-  std::array<double, 3> applied_force{};    ///< s int t dS_0
+  std::array<double, 3> applied_force{};    ///< s int t dS_0 (+ the fixed loads)
   std::array<double, 3> applied_moment{};   ///< s int (x + u) x t dS_0 (deformed positions)
   std::array<double, 3> applied_moment_reference{};  ///< s int x x t dS_0 (reference positions)
 };
@@ -54,12 +56,17 @@ class Problem {
   DM dm() const { return space_->dm(); }
   MPI_Comm comm() const { return space_->comm(); }
   const std::vector<EffectPtr>& effects() const { return effects_; }
-  /// The nominal external load f_ext (global vector).
+  /// The nominal external load f_ext, the part the load factor scales (global vector).
   Vec load() const { return load_.get(); }
   double load_norm() const { return load_norm_; }
-  /// Re-runs the set-up of the load effects and reassembles f_ext, after a load effect was
+  /// The fixed load f_fixed (global vector), or null when no effect has one.
+  Vec fixed_load() const { return fixed_load_.get(); }
+  /// Re-runs the set-up of the load effects and reassembles f_ext and f_fixed, after a load effect was
   /// changed (e.g. GaussianTraction::set for the next load case). Collective.
   void reassemble_load();
+  /// Replaces load effect `index` (of effects(); a load without energy or constraints) by
+  /// `effect`, e.g. the next load case's; call reassemble_load() before use. Not collective.
+  void replace_load(std::size_t index, EffectPtr effect);
 
   /// Each returns false (on every rank) if u has det F <= 0 at some quadrature point. Collective.
   bool energy(Vec u, double load_factor, double& value) const;
@@ -88,9 +95,11 @@ class Problem {
   /// Global -> local with the essential values inserted.
   void to_local(Vec u, Vec ul) const;
   void assemble_load();
+  /// Assembles the loads of the effects with scaled() == `scaled` into `f` (global).
+  void assemble_loads(bool scaled, Vec f) const;
   std::vector<EffectPtr> effects_;
   std::unique_ptr<Space> space_;
-  core::VecH load_;
+  core::VecH load_, fixed_load_;
   double load_norm_ = 0;
   mutable core::MatH pattern_;  ///< the tangent's pattern, from the DM once (create_matrix)
 };

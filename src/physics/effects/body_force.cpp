@@ -10,6 +10,8 @@ class BodyForce : public Effect {
   explicit BodyForce(VectorFunction b) : b_(std::move(b)) {}
   std::string name() const override { return "body_force"; }
   bool has_load() const override { return true; }
+  std::string channel() const override { return "body_force"; }
+  void channel_value(const double* x, double* b) const override { b_(x, b); }
   void add_load(const Space& s, PetscScalar* f) const override {
     const int dim = s.dim(), nb = s.n_nodes();
     for (PetscInt c = s.cell_begin(); c < s.cell_end(); ++c) {
@@ -42,7 +44,8 @@ void register_body_force() {
           for (int i = 0; i < dim; ++i) b[i] = v[i];
         });
       },
-      "uniform dead body force per unit reference volume (scaled by alpha); key: value");
+      "uniform dead body force per unit reference volume; key: value (a vector); scale: alpha "
+      "(default) | fixed");
 }
 
 }  // namespace hypershape::physics
