@@ -128,15 +128,15 @@ void LdltFactor::set_up_blocked(Mat A) {
     return;
   }
   const PetscInt nb = n / 2;
-  // A fill-reducing ordering of the nodes: nested dissection on the 2x2-block graph (measured:
-  // numeric factorisation 20% faster than approximate minimum degree, 2.8 against 3.5 ms at P1
-  // h 0.04, 13.6 against 16.1 ms at P2 h 0.05, 12.7k unknowns, where MUMPS took 18 ms).
+  // A fill-reducing ordering of the nodes: approximate minimum degree on the 2x2-block graph.
+  // (PETSc's nested dissection instead made the factorisations 1.7x (P1 h 0.04) and 3.3x (P2
+  // h 0.12) slower on Random2D slices, measured side by side with scripts/bench_versions.sh.)
   std::vector<PetscInt> new_block(static_cast<std::size_t>(nb));
   {
     core::MatH B;
     HS_PETSC(MatConvert(A, MATSEQBAIJ, MAT_INITIAL_MATRIX, B.out()));
     core::ISH rp, cp;
-    HS_PETSC(MatGetOrdering(B, MATORDERINGND, rp.out(), cp.out()));
+    HS_PETSC(MatGetOrdering(B, MATORDERINGAMD, rp.out(), cp.out()));
     PetscInt m;
     HS_PETSC(ISGetSize(rp, &m));
     if (m != nb) throw std::logic_error("block ordering of the wrong size");

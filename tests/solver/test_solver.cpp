@@ -379,7 +379,7 @@ TEST_CASE("The inertia of LDL^T counts the negative eigenvalues, with PETSc's fa
   }
 }
 
-TEST_CASE("The blocked LDL^T (2x2 nodes, nested dissection) solves as MUMPS does and counts the same inertia",
+TEST_CASE("The blocked LDL^T (2x2 nodes, AMD ordering) solves as MUMPS does and counts the same inertia",
           "[solver]") {
   // K - sigma I of a P1 and a P2 tangent, indefinite by design: the blocked factor's solution
   // and inertia against MUMPS on the same matrix. The factor is refactorised in place (the

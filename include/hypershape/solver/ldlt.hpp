@@ -4,7 +4,7 @@
 /// Two kinds, chosen once per problem:
 ///  - blocked (2D, one rank, PETSc's own factorisation, block size 2): the tangent's values are
 ///    scattered into a symmetric block matrix (SBAIJ, 2x2 blocks, one per node) in a fill-reducing
-///    ordering of the nodes (nested dissection on the node graph, computed once), and
+///    ordering of the nodes (approximate minimum degree on the node graph, computed once), and
 ///    factored by PETSc's blocked U^T D U kernel. Measured on the disk (P1 h 0.04, 4.7k unknowns):
 ///    numeric factorisation 2.3-3.6x faster and triangular solves 2.3x faster than the scalar
 ///    factorisation of the AIJ matrix in the qmd ordering, with as many nonzeros in the factor.
