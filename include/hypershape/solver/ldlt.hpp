@@ -59,6 +59,10 @@ class LdltFactor {
 
  private:
   void set_up_blocked(Mat A);
+  /// The new block index of each node (old block), and old_of_new_ (scalar).
+  std::vector<PetscInt> node_ordering(Mat A);
+  /// F_ with the upper 2x2-block pattern of A in the new ordering, and value_map_.
+  void build_block_pattern(Mat A, const std::vector<PetscInt>& new_block);
   void scatter_values(Mat A);
   /// Blocked kind: GMRES on F_ preconditioned by the factor where the solve lost digits.
   void refine();
