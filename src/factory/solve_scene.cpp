@@ -30,6 +30,75 @@ std::optional<mesh::ClampRegion> clamp_of(const std::vector<physics::ResolvedEff
   return std::nullopt;
 }
 
+/// Each target of `runs` (or the scene's target or alpha) solved in turn, `runs.repeat` times
+/// over, each from rest on the same solver; the last one's outcome in `o`. Collective.
+void solve_load_cases(const physics::Problem& problem, solver::NonlinearSolver& nl, config::Scene& scene,
+                      const SceneRuns& runs, SceneOutcome& o) {
+  std::vector<std::optional<double>> targets;
+  for (double v : runs.targets) targets.emplace_back(v);
+  if (targets.empty()) targets.push_back(scene.target);
+  for (int rep = 0; rep < std::max(runs.repeat, 1); ++rep)
+    for (const auto& target : targets) {
+      if (!o.load_cases.empty()) nl.reset();
+      const double t0 = core::now_seconds();
+      if (target) {
+        auto r = nl.solve_for_target(*target);
+        o.converged = r.converged;
+        o.reason = r.reason;
+        o.alpha = r.alpha;
+        o.newton_iterations = r.newton_iterations;
+        o.solves = r.solves;
+        o.failed_increments = r.failed_increments;
+      } else {
+        auto r = nl.solve(*scene.alpha);
+        o.converged = r.converged;
+        o.reason = r.reason;
+        o.alpha = r.load_factor;
+        o.newton_iterations = r.newton_iterations;
+        o.solves = 1;
+        o.failed_increments = r.failed_increments;
+      }
+      const double seconds = core::now_seconds() - t0;
+      o.load_cases.push_back({target.value_or(0.0), o.alpha, problem.max_displacement(nl.solution()), seconds,
+                              o.newton_iterations, o.converged});
+    }
+  if (targets.back()) scene.target = targets.back();
+  o.max_displacement = problem.max_displacement(nl.solution());
+  o.min_det_f = problem.min_det_f(nl.solution());
+}
+
+/// The solution file's record (rank 0): mesh, displacement, the scene, numbers, timings.
+void fill_record(const physics::Space& sp, const config::Scene& scene, std::vector<double> displacement,
+                 SceneOutcome& o) {
+  auto& r = o.record;
+  r.dim = o.dim;
+  r.degree = o.degree;
+  r.n_vertices = o.n_vertices;
+  r.nodes = sp.canonical_coords();
+  r.cells = sp.canonical_cells();
+  r.displacement = std::move(displacement);
+  r.scene_text = scene.text;
+  r.numbers = {{"alpha", o.alpha},
+               {"max_displacement", o.max_displacement},
+               {"min_det_F", o.min_det_f},
+               {"converged", o.converged ? 1.0 : 0.0},
+               {"newton_iterations", double(o.newton_iterations)}};
+  if (scene.target) r.numbers["target"] = *scene.target;
+  r.strings = {{"reason", o.reason}, {"source", scene.source}};
+  if (o.load_cases.size() > 1) {
+    auto column = [&](const char* name, auto get) {
+      auto& v = r.timings[name];
+      for (const auto& c : o.load_cases) v.push_back(double(get(c)));
+    };
+    column("target", [](const auto& c) { return c.target; });
+    column("alpha", [](const auto& c) { return c.alpha; });
+    column("max_displacement", [](const auto& c) { return c.max_displacement; });
+    column("converged", [](const auto& c) { return c.converged; });
+    column("newton_iterations", [](const auto& c) { return c.newton_iterations; });
+  }
+  for (const auto& c : o.load_cases) r.timings["seconds"].push_back(c.seconds);
+}
+
 }  // namespace
 
 SceneOutcome solve_scene(MPI_Comm comm, const config::Scene& scene_in, const SceneRuns& runs) {
@@ -77,37 +146,7 @@ SceneOutcome solve_scene(MPI_Comm comm, const config::Scene& scene_in, const Sce
   }
   {
     auto t = o.times.scope("solve");
-    std::vector<std::optional<double>> targets;
-    for (double v : runs.targets) targets.emplace_back(v);
-    if (targets.empty()) targets.push_back(scene.target);
-    for (int rep = 0; rep < std::max(runs.repeat, 1); ++rep)
-      for (const auto& target : targets) {
-        if (!o.load_cases.empty()) nl->reset();
-        const double t0 = core::now_seconds();
-        if (target) {
-          auto r = nl->solve_for_target(*target);
-          o.converged = r.converged;
-          o.reason = r.reason;
-          o.alpha = r.alpha;
-          o.newton_iterations = r.newton_iterations;
-          o.solves = r.solves;
-          o.failed_increments = r.failed_increments;
-        } else {
-          auto r = nl->solve(*scene.alpha);
-          o.converged = r.converged;
-          o.reason = r.reason;
-          o.alpha = r.load_factor;
-          o.newton_iterations = r.newton_iterations;
-          o.solves = 1;
-          o.failed_increments = r.failed_increments;
-        }
-        const double seconds = core::now_seconds() - t0;
-        o.load_cases.push_back({target.value_or(0.0), o.alpha, problem->max_displacement(nl->solution()),
-                                seconds, o.newton_iterations, o.converged});
-      }
-    if (targets.back()) scene.target = targets.back();
-    o.max_displacement = problem->max_displacement(nl->solution());
-    o.min_det_f = problem->min_det_f(nl->solution());
+    solve_load_cases(*problem, *nl, scene, runs, o);
   }
   const auto& sp = problem->space();
   o.dim = sp.dim();
@@ -118,35 +157,7 @@ SceneOutcome solve_scene(MPI_Comm comm, const config::Scene& scene_in, const Sce
   {
     auto t = o.times.scope("gather");
     auto field = problem->gather(nl->solution());
-    if (core::rank(comm) == 0) {
-      auto& r = o.record;
-      r.dim = o.dim;
-      r.degree = o.degree;
-      r.n_vertices = o.n_vertices;
-      r.nodes = sp.canonical_coords();
-      r.cells = sp.canonical_cells();
-      r.displacement = std::move(field.values);
-      r.scene_text = scene.text;
-      r.numbers = {{"alpha", o.alpha},
-                   {"max_displacement", o.max_displacement},
-                   {"min_det_F", o.min_det_f},
-                   {"converged", o.converged ? 1.0 : 0.0},
-                   {"newton_iterations", double(o.newton_iterations)}};
-      if (scene.target) r.numbers["target"] = *scene.target;
-      r.strings = {{"reason", o.reason}, {"source", scene.source}};
-      if (o.load_cases.size() > 1) {
-        auto column = [&](const char* name, auto get) {
-          auto& v = r.timings[name];
-          for (const auto& c : o.load_cases) v.push_back(double(get(c)));
-        };
-        column("target", [](const auto& c) { return c.target; });
-        column("alpha", [](const auto& c) { return c.alpha; });
-        column("max_displacement", [](const auto& c) { return c.max_displacement; });
-        column("converged", [](const auto& c) { return c.converged; });
-        column("newton_iterations", [](const auto& c) { return c.newton_iterations; });
-      }
-      for (const auto& c : o.load_cases) r.timings["seconds"].push_back(c.seconds);
-    }
+    if (core::rank(comm) == 0) fill_record(sp, scene, std::move(field.values), o);
   }
   return o;
 }
