@@ -46,6 +46,56 @@ void check_output_path(const std::string& out) {
   if (access(dir.c_str(), W_OK) != 0) throw core::InputError("", "-o", "directory is not writable: " + dir.string());
 }
 
+int run_generate(MPI_Comm comm, const std::string& config_path, const std::string& out,
+                 factory::GenerateOptions gen) {
+  mesh::GmshSession gmsh;
+  const config::DatasetConfig cfg =
+      config_path.empty() ? config::parse_dataset_text(config::default_dataset_text(), "<default dataset>")
+                          : config::parse_dataset_file(config_path);
+  gen.output_dir = out.empty() ? "results/" + cfg.name : out;
+  const auto report = factory::generate(comm, cfg, gen);
+  core::info(comm, "[generate] done{}:\n{}", report.indexed ? " (dataset complete: manifest, splits, stats written)"
+                                                             : " (slice written; run `hypershape index` when all are)",
+             factory::report_table(report));
+  return 0;
+}
+
+int run_index(MPI_Comm comm, const std::string& dir) {
+  factory::IndexReport r;
+  core::on_root(comm, [&] { r = factory::index_dataset(dir); });
+  std::string missing;
+  for (auto k : r.missing_shards) missing += (missing.empty() ? "" : ", ") + std::to_string(k);
+  core::info(comm, "{}: {} shards, {} shapes ({} failed), {} load cases converged, {} failed{}", dir, r.shards,
+             r.shapes_ok + r.shapes_failed, r.shapes_failed, r.loads_ok, r.loads_failed,
+             r.complete() ? "; complete" : "; INCOMPLETE, missing shards: " + missing);
+  int complete = r.complete();
+  MPI_Bcast(&complete, 1, MPI_INT, 0, comm);
+  return complete ? 0 : 4;
+}
+
+int run_shapes(MPI_Comm comm, const std::string& config_path, const std::string& out, std::int64_t first,
+               std::int64_t count) {
+  check_output_path(out);
+  mesh::GmshSession gmsh;  // one gmsh session for all shapes of this rank
+  const config::DatasetConfig cfg = config::parse_dataset_file(config_path);
+  if (count < 0) count = cfg.n_shapes - first;
+  if (count < 1 || first + count > cfg.n_shapes)
+    throw core::InputError(config_path, "shapes.count",
+                           fmt::format("--first {} and --count {} must select shapes within [0, {})", first,
+                                       count, cfg.n_shapes));
+  core::info(comm, "{}: drawing shapes {}..{} on {} rank(s)", cfg.name, first, first + count - 1, core::size(comm));
+  const double t0 = core::now_seconds();
+  const auto records = factory::make_shape_range(comm, cfg, first, count);
+  int n_failed = 0;
+  if (core::rank(comm) == 0) {
+    for (const auto& r : records) n_failed += r.numbers.at("failed") != 0;
+    io::write_shapes(out, records, cfg.text, cfg.name, cfg.seed);
+  }
+  MPI_Bcast(&n_failed, 1, MPI_INT, 0, comm);
+  core::info(comm, "{} shapes ({} failed) in {:.1f} s -> {}", count, n_failed, core::now_seconds() - t0, out);
+  return n_failed ? 3 : 0;
+}
+
 int run(int argc, char** argv) {
   MPI_Comm comm = PETSC_COMM_WORLD;
   const int rank = core::rank(comm);
@@ -112,53 +162,9 @@ int run(int argc, char** argv) {
     for (auto& [name, help] : physics::registered_effects()) core::info(comm, "{:20s} {}", name, help);
     return 0;
   }
-  if (*generate) {
-    mesh::GmshSession gmsh;
-    const config::DatasetConfig cfg =
-        gen_config.empty() ? config::parse_dataset_text(config::default_dataset_text(), "<default dataset>")
-                           : config::parse_dataset_file(gen_config);
-    gen.output_dir = gen_out.empty() ? "results/" + cfg.name : gen_out;
-    const auto report = factory::generate(comm, cfg, gen);
-    core::info(comm, "[generate] done{}:\n{}", report.indexed ? " (dataset complete: manifest, splits, stats written)"
-                                                               : " (slice written; run `hypershape index` when all are)",
-               factory::report_table(report));
-    return 0;
-  }
-  if (*index) {
-    factory::IndexReport r;
-    core::on_root(comm, [&] { r = factory::index_dataset(index_dir); });
-    std::string missing;
-    for (auto k : r.missing_shards) missing += (missing.empty() ? "" : ", ") + std::to_string(k);
-    core::info(comm, "{}: {} shards, {} shapes ({} failed), {} load cases converged, {} failed{}", index_dir,
-               r.shards, r.shapes_ok + r.shapes_failed, r.shapes_failed, r.loads_ok, r.loads_failed,
-               r.complete() ? "; complete" : "; INCOMPLETE, missing shards: " + missing);
-    int complete = r.complete();
-    MPI_Bcast(&complete, 1, MPI_INT, 0, comm);
-    return complete ? 0 : 4;
-  }
-  if (*shapes) {
-    check_output_path(shapes_out);
-    mesh::GmshSession gmsh;  // one gmsh session for all shapes of this rank
-    const config::DatasetConfig cfg = config::parse_dataset_file(shapes_config);
-    if (count < 0) count = cfg.n_shapes - first;
-    if (count < 1 || first + count > cfg.n_shapes)
-      throw core::InputError(shapes_config, "shapes.count",
-                             fmt::format("--first {} and --count {} must select shapes within [0, {})",
-                                         first, count, cfg.n_shapes));
-    core::info(comm, "{}: drawing shapes {}..{} on {} rank(s)", cfg.name, first, first + count - 1,
-               core::size(comm));
-    const double t0 = core::now_seconds();
-    const auto records = factory::make_shape_range(comm, cfg, first, count);
-    int n_failed = 0;
-    if (rank == 0) {
-      for (const auto& r : records) n_failed += r.numbers.at("failed") != 0;
-      io::write_shapes(shapes_out, records, cfg.text, cfg.name, cfg.seed);
-    }
-    MPI_Bcast(&n_failed, 1, MPI_INT, 0, comm);
-    core::info(comm, "{} shapes ({} failed) in {:.1f} s -> {}", count, n_failed,
-               core::now_seconds() - t0, shapes_out);
-    return n_failed ? 3 : 0;
-  }
+  if (*generate) return run_generate(comm, gen_config, gen_out, gen);
+  if (*index) return run_index(comm, index_dir);
+  if (*shapes) return run_shapes(comm, shapes_config, shapes_out, first, count);
   // Validate everything that can be validated before any work or output.
   check_output_path(out);
   config::Scene scene = scene_path.empty()
