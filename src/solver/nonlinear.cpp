@@ -431,6 +431,8 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
     HS_PETSC(VecAXPBYPCZ(du_, 1.0, -dalpha, 0.0, b_, a_));  // Y = -du = b - dalpha a
     HS_PETSC(VecAXPY(r_, -dalpha, problem_.load()));       // R(u, s + dalpha)
     const double lambda = backtrack(u_, du_, r_, s_full, w_, b_);
+    HS_PETSC(PetscInfo(snes_.get(), "corrector %d: |R| %g (%g to go), |u_k| - d %g, dalpha %g, step %g, %d negative pivots\n", k, rn,
+                       rn / (opt_.atol + rtol * std::abs(s_) * fnorm), g, dalpha, lambda, negative_pivots_));
     if (lambda == 0.0) {
       why = "line search found no admissible decrease";
       return false;
@@ -478,7 +480,27 @@ double NonlinearSolver::softest_mode() {
   return vkv / vv;
 }
 
-bool NonlinearSolver::minimise(double s, int& its, std::string& why) {
+bool NonlinearSolver::descend_softest_mode(double s, double eps) {
+  if (!(softest_mode() < 0)) return false;  // v_: the mode of K's eigenvalue nearest zero
+  PetscReal rv;
+  HS_PETSC(VecDot(r_, v_, &rv));  // the energy's slope along +v_ is R . v_
+  const double sign = rv > 0 ? -1.0 : 1.0;
+  double e0;
+  if (!problem_.energy(u_, s, e0)) return false;
+  auto energy_at = [&](double t) {
+    HS_PETSC(VecWAXPY(w_, sign * t, v_, u_));
+    double e;
+    return problem_.energy(w_, s, e) ? e : INFINITY;
+  };
+  double t = eps;  // the first of eps, eps/2, ... that lowers the energy
+  while (!(energy_at(t) < e0))
+    if ((t *= 0.5) < 1e-3 * eps) return false;
+  HS_PETSC(PetscInfo(snes_.get(), "minimise: a step of %g along negative curvature\n", t));
+  HS_PETSC(VecAXPY(u_, sign * t, v_));
+  return true;
+}
+
+bool NonlinearSolver::minimise(double s, double eps, int& its, std::string& why) {
   const double fnorm = problem_.load_norm();
   double mu = 0, mu0 = 0;
   for (int k = 0;; ++k) {
@@ -514,12 +536,22 @@ bool NonlinearSolver::minimise(double s, int& its, std::string& why) {
     // The inertia decides the shift: a factorisation of this very (shifted) tangent.
     const bool solved = tangent_->factorise() && tangent_->apply_factor(r_, du_);
     negative_pivots_ = solved ? tangent_->negative_eigenvalues() : -1;
+    if (solved && mu == 0 && negative_pivots_ > 0 && descend_softest_mode(s, eps)) {
+      // Indefinite where the shifted steps had led: a saddle's neighbourhood, whose gradient
+      // is too small for a shifted Newton step to leave it (measured: the shift cycled, the
+      // residual stalled, 48 iterations). Its way down is along negative curvature.
+      mu = mu0 / 4;
+      negative_pivots_ = -1;
+      continue;
+    }
     if (!solved || negative_pivots_ != 0) {  // indefinite (or failed): shift further
       mu = mu == 0 ? mu0 : 4 * mu;
       negative_pivots_ = -1;
       continue;
     }
     const double lambda = backtrack(u_, du_, r_, s, w_, b_);
+    HS_PETSC(PetscInfo(snes_.get(), "minimise %d: |R| %g (%g to go), shift %g, step %g\n", k, rn,
+                       rn / (opt_.atol + opt_.rtol * std::abs(s) * fnorm), mu, lambda));
     if (lambda == 0.0) {
       mu = mu == 0 ? mu0 : 4 * mu;
       negative_pivots_ = -1;
@@ -565,7 +597,7 @@ void NonlinearSolver::switch_branch(double target, double start, int attempt, Ta
   } else {
     why = "tangent factorisation failed";
   }
-  if (ok) ok = minimise(s_, its, why);
+  if (ok) ok = minimise(s_, 0.05 * target, its, why);
   const std::string before = t.reason;
   t.recovery_iterations += its - t.newton_iterations;
   t.newton_iterations = its;
@@ -672,12 +704,12 @@ TargetResult NonlinearSolver::follow_path(double target, double start, int spent
       if (n <= 3) step *= 2.0; else if (n >= 8) step *= 0.5;
       continue;
     }
+    ++t.failed_increments;
+    t.recovery_iterations += its - its_before;
     HS_PETSC(VecCopy(backup_, u_));
     HS_PETSC(VecCopy(a0_, a_));
     s_ = s_backup;
-    ++t.failed_increments;
-    t.recovery_iterations += its - its_before;
-    step *= 0.5;
+    step = 0.5 * (d_next - d);  // half the increment that failed (step may have been longer)
     if (++failed_in_a_row == opt_.max_halvings) {
       t.reason = std::to_string(failed_in_a_row) + " failed increments in a row (last: " + why + ")";
       break;

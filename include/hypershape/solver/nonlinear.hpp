@@ -184,7 +184,11 @@ class NonlinearSolver {
   /// Minimises the energy at load factor s from u_ by Newton with an inertia correction:
   /// K + mu I, mu raised until LDL^T has no negative pivot, lowered after full steps. Ends at
   /// an equilibrium whose tangent is positive definite, or returns false with `why`.
-  bool minimise(double s, int& its, std::string& why);
+  /// `eps`: the length of a step along negative curvature (descend_softest_mode).
+  bool minimise(double s, double eps, int& its, std::string& why);
+  /// Where K(u_) is factorised and indefinite: moves u_ along the softest mode (eigenvalue < 0)
+  /// by the first of eps, eps/2, ... that lowers the energy at load s. False if none does.
+  bool descend_softest_mode(double s, double eps);
 
   const physics::Problem& problem_;
   SolverOptions opt_;
