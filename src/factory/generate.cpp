@@ -1,7 +1,6 @@
 #include "hypershape/factory/generate.hpp"
 
 #include <fmt/format.h>
-#include <gmsh.h>
 #include <nlohmann/json.hpp>
 #include <petscsys.h>
 #include <sys/resource.h>
@@ -21,6 +20,7 @@
 #include "hypershape/factory/shape_pipeline.hpp"
 #include "hypershape/factory/shape_set.hpp"
 #include "hypershape/io/dataset_shard.hpp"
+#include "hypershape/mesh/gmsh_mesher.hpp"
 #include "hypershape/solver/nonlinear.hpp"
 #include "text_file.hpp"
 
@@ -80,9 +80,7 @@ double peak_rss_mib() {
 std::map<std::string, std::string> software_versions() {
   char petsc[256];
   PetscGetVersion(petsc, sizeof petsc);
-  std::string gmsh_version;
-  gmsh::option::getString("General.Version", gmsh_version);
-  return {{"petsc", petsc}, {"gmsh", gmsh_version}};
+  return {{"petsc", petsc}, {"gmsh", mesh::gmsh_version()}};
 }
 
 /// Output checks and the shards this task still has to write (rank 0; throws InputError).

@@ -1,4 +1,5 @@
 #include "hypershape/factory/shape_job.hpp"
+#include "hypershape/mesh/reference_cell.hpp"
 
 #include <fmt/format.h>
 
@@ -59,17 +60,13 @@ void boundary_node_masks(const geometry::Boundary& b, const std::vector<int>& di
   neumann.assign(std::size_t(n_nodes), 0);
   std::map<std::pair<std::int64_t, std::int64_t>, std::int64_t> midpoint;
   if (degree == 2) {
-    static const int tri[3][3] = {{0, 1, 3}, {1, 2, 4}, {2, 0, 5}};
-    static const int tet[6][3] = {{0, 1, 4}, {1, 2, 5}, {2, 0, 6}, {0, 3, 7}, {1, 3, 8}, {2, 3, 9}};
-    const int per = d == 2 ? 6 : 10;
-    for (std::size_t c = 0; c + std::size_t(per) <= cells.size(); c += std::size_t(per)) {
-      const int n_edges = d == 2 ? 3 : 6;
-      for (int e = 0; e < n_edges; ++e) {
-        const int* t = d == 2 ? tri[e] : tet[e];
-        auto a = cells[c + std::size_t(t[0])], z = cells[c + std::size_t(t[1])];
-        midpoint[{std::min(a, z), std::max(a, z)}] = cells[c + std::size_t(t[2])];
+    const auto per = std::size_t(mesh::nodes_per_cell(d, 2));
+    const auto edges = mesh::edges(d);
+    for (std::size_t c = 0; c + per <= cells.size(); c += per)
+      for (std::size_t e = 0; e < edges.size(); ++e) {
+        auto a = cells[c + std::size_t(edges[e].first)], z = cells[c + std::size_t(edges[e].second)];
+        midpoint[{std::min(a, z), std::max(a, z)}] = cells[c + std::size_t(d + 1) + e];
       }
-    }
   }
   std::vector<std::uint8_t> is_dirichlet(std::size_t(b.n_facets()), 0);
   for (int f : dirichlet_facets) is_dirichlet[std::size_t(f)] = 1;
@@ -361,9 +358,9 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
       r = nl->solve_for_target(lc.target);
       out.times.add("solve", r.seconds_first_solve);
       out.times.add("alpha_search", r.seconds_total - r.seconds_first_solve);
-    } catch (const std::exception& e) {
+    } catch (const std::runtime_error& e) {  // PETSc's and the solver's failures: data
       failure = std::string("error: ") + e.what();
-    }
+    }  // a std::logic_error is a bug: it ends the run (the shard is redone on resume)
     newton[L] = r.newton_iterations;
     solves[L] = r.solves;
     failed_inc[L] = r.failed_increments;

@@ -151,6 +151,12 @@ GmshSession::~GmshSession() {
 
 bool GmshSession::active() { return g_sessions > 0; }
 
+std::string gmsh_version() {
+  std::string v;
+  gmsh::option::getString("General.Version", v);
+  return v;
+}
+
 MeshData mesh_disk(const MeshOptions& opt, const std::optional<ClampRegion>& clamp) {
   return guarded("meshing the unit disk", [&] {
     ScopedModel model("disk");

@@ -1,4 +1,5 @@
 #include "hypershape/physics/space.hpp"
+#include "hypershape/mesh/reference_cell.hpp"
 
 #include <petscds.h>
 
@@ -318,17 +319,13 @@ Space::Space(core::DMH dm, DM serial, PetscSF migration, const SpaceOptions& opt
       }
     PetscInt sc0, sc1;
     HS_PETSC(DMPlexGetHeightStratum(serial, 0, &sc0, &sc1));
-    static const int tri_edges[3][2] = {{0, 1}, {1, 2}, {2, 0}};
-    static const int tet_edges[6][2] = {{0, 1}, {1, 2}, {0, 2}, {0, 3}, {1, 3}, {2, 3}};
     for (PetscInt c = sc0; c < sc1; ++c) {
       auto v = closure_of_depth(serial, c, strata[0], strata[1]);
       if (dim_ == 3) std::swap(v[1], v[2]);  // PETSc's left-handed tetrahedra -> VTK's
       for (auto p : v) canonical_cells_.push_back(canonical(p));
       if (degree_ == 2) {
-        const int ne = dim_ == 2 ? 3 : 6;
-        for (int e = 0; e < ne; ++e) {
-          const int* ab = dim_ == 2 ? tri_edges[e] : tet_edges[e];
-          const PetscInt pair[2] = {v[ab[0]], v[ab[1]]};
+        for (const auto& [a, b] : mesh::edges(dim_)) {
+          const PetscInt pair[2] = {v[a], v[b]};
           PetscInt nj;
           const PetscInt* join;
           HS_PETSC(DMPlexGetJoin(serial, 2, pair, &nj, &join));

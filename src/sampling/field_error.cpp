@@ -1,4 +1,5 @@
 #include "hypershape/sampling/field_error.hpp"
+#include "hypershape/mesh/reference_cell.hpp"
 
 #include <Eigen/Dense>
 #include <array>
@@ -9,10 +10,6 @@
 namespace hypershape::sampling {
 
 namespace {
-
-/// The P2 edges of a simplex in VTK order.
-constexpr int kTriEdges[3][2] = {{0, 1}, {1, 2}, {2, 0}};
-constexpr int kTetEdges[6][2] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}};
 
 /// C[(n * k + j) * nv + a] = d phi_j / d lambda_a at local node n of the k-node simplex: the
 /// gradient of basis j at node n is sum_a C[n, j, a] grad(lambda_a).
@@ -25,17 +22,17 @@ std::vector<double> basis_gradients_at_nodes(int dim, int k) {
       for (int j = 0; j < k; ++j) at(n, j, j) = 1.0;
     return C;
   }
-  const int n_edges = dim == 2 ? 3 : 6;
-  const auto& edges = dim == 2 ? kTriEdges : kTetEdges;
+  const auto edges = mesh::edges(dim);
+  const int n_edges = int(edges.size());
   std::vector<std::array<double, 4>> bary(std::size_t(k), {0, 0, 0, 0});
   for (int v = 0; v < nv; ++v) bary[std::size_t(v)][std::size_t(v)] = 1.0;
   for (int e = 0; e < n_edges; ++e)
-    bary[std::size_t(nv + e)][std::size_t(edges[e][0])] = bary[std::size_t(nv + e)][std::size_t(edges[e][1])] = 0.5;
+    bary[std::size_t(nv + e)][std::size_t(edges[e].first)] = bary[std::size_t(nv + e)][std::size_t(edges[e].second)] = 0.5;
   for (int n = 0; n < k; ++n) {
     const auto& lam = bary[std::size_t(n)];
     for (int j = 0; j < nv; ++j) at(n, j, j) = 4.0 * lam[std::size_t(j)] - 1.0;  // lambda_j (2 lambda_j - 1)
     for (int e = 0; e < n_edges; ++e) {  // 4 lambda_a lambda_b
-      const int a = edges[e][0], b = edges[e][1];
+      const auto [a, b] = edges[std::size_t(e)];
       at(n, nv + e, a) = 4.0 * lam[std::size_t(b)];
       at(n, nv + e, b) = 4.0 * lam[std::size_t(a)];
     }

@@ -1,4 +1,5 @@
 #include "hypershape/sampling/mesh_sampler.hpp"
+#include "hypershape/mesh/reference_cell.hpp"
 
 #include <algorithm>
 #include <array>
@@ -26,24 +27,8 @@ constexpr double kNear = 1e-6;
   throw std::invalid_argument("MeshSampler: " + what);
 }
 
-int nodes_per_cell(int dim, int degree) {
-  if (degree == 1) return dim + 1;
-  return dim == 2 ? 6 : 10;
-}
-
-/// Local node of the midpoint of the edge between local vertices a != b (VTK order).
-int edge_node(int dim, int a, int b) {
-  if (a > b) std::swap(a, b);
-  if (dim == 2) {
-    // m01 m12 m20
-    if (a == 0) return b == 1 ? 3 : 5;
-    return 4;
-  }
-  // m01 m12 m20 m03 m13 m23
-  if (b == 3) return 7 + a;
-  if (a == 0) return b == 1 ? 4 : 6;
-  return 5;
-}
+using mesh::edge_node;
+using mesh::nodes_per_cell;
 
 /// Lagrange basis at barycentric coordinates `l` (dim + 1 of them): P1 or P2 in VTK order.
 void cell_basis(int dim, int degree, const double* l, double* w) {

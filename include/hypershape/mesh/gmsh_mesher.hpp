@@ -19,6 +19,9 @@ class GmshSession {
 };
 
 /// Mesh-size controls.
+/// gmsh's version string (a GmshSession must be open).
+std::string gmsh_version();
+
 struct MeshOptions {
   double h = 0.05;          ///< target element size away from the clamp ends
   double clamp_size = 0.0;  ///< size at the clamp ends (0: h, no grading)
