@@ -59,9 +59,12 @@ if all_completed "$index"; then ok "index job $index (afterok:$array) COMPLETED 
 else fail "index job: $(states "$index")"; cat "$work"/index-*.out; fi
 if compare "$work/ref" "$work/array"; then ok "3-task array + index job == one process, bit for bit"
 else fail "array != one process"; fi
+n_reports=0
 for t in 0 1 2; do
-  [ -f "$work/array/reports/task-$t-of-3.json" ] || fail "no report of array task $t"
+  [ -f "$work/array/reports/task-00$t-of-003.json" ] && n_reports=$((n_reports + 1))
 done
+if [ "$n_reports" -eq 3 ]; then ok "a run report of each of the 3 array tasks (reports/task-00I-of-003.json)"
+else fail "$n_reports of 3 array task reports"; ls "$work/array/reports"; fi
 
 if all_completed "$group"; then ok "group job $group (2 tasks, srun --mpi=pmix) COMPLETED 0:0"
 else fail "group job: $(states "$group")"; cat "$work"/group-*.out; fi
