@@ -9,7 +9,7 @@
 #   scripts/slurm/local_cluster.sh status [DIR]  # sinfo
 #
 # DIR defaults to /tmp/hypershape-slurm. The cluster is one node (this host, 127.0.0.1) with
-# all its CPUs, one partition `test`, ports SLURM_PORT and SLURM_PORT + 1 (default 6917/6918,
+# all its CPUs (at least 2), one partition `test`, ports SLURM_PORT and SLURM_PORT + 1 (default 6917/6918,
 # away from a system SLURM's 6817/6818), munge on its own socket and key (nothing in /etc is
 # used or changed). Process tracking by /proc and no task plugin: no cgroups are needed.
 # sbatch/srun/squeue/sacct need SLURM_CONF=DIR/slurm.conf in the environment.
@@ -35,7 +35,10 @@ install_missing() {
 write_conf() {
   local host cpus mem
   host=$(hostname -s)
-  cpus=$(nproc)
+  # getconf, not nproc (nproc follows OMP_NUM_THREADS); at least 2, so that a 2-rank job runs
+  # on a 1-core machine too (config_overrides lets slurmd accept more CPUs than it counts).
+  cpus=$(getconf _NPROCESSORS_ONLN)
+  ((cpus >= 2)) || cpus=2
   mem=$(( $(awk '/MemTotal/ {print $2}' /proc/meminfo) / 1024 / 2 ))
   cat >"$DIR/slurm.conf" <<EOF
 ClusterName=hypershape-test
@@ -44,6 +47,7 @@ SlurmctldPort=$PORT
 SlurmdPort=$((PORT + 1))
 SlurmUser=root
 SlurmdUser=root
+SlurmdParameters=config_overrides
 AuthType=auth/munge
 CredType=cred/munge
 AuthInfo=socket=$DIR/munge/munge.socket
