@@ -13,6 +13,16 @@
 . "$(dirname "$0")/../cli/lib.sh"
 cluster=$work/cluster
 trap '"$src/scripts/slurm/local_cluster.sh" stop "$cluster"; rm -rf "$work"' EXIT
+# Two free ports in a row for slurmctld/slurmd (another cluster may be up on the defaults).
+SLURM_PORT=$(/usr/bin/python3 -c 'import socket
+for p in range(16917, 17917, 2):
+    try:
+        ss = [socket.socket() for _ in range(2)]
+        [s.bind(("127.0.0.1", p + i)) for i, s in enumerate(ss)]
+        print(p); break
+    except OSError: pass
+    finally: [s.close() for s in ss]')
+export SLURM_PORT
 "$src/scripts/slurm/local_cluster.sh" start "$cluster" || { fail "cluster did not start"; finish; exit 1; }
 export SLURM_CONF=$cluster/slurm.conf
 compare() { /usr/bin/python3 "$src/tests/cli/compare_datasets.py" "$@"; }
