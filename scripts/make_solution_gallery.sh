@@ -19,12 +19,10 @@
 #   OUT_DIR         figures (default docs/figures)
 set -euo pipefail
 
-ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-cd "$ROOT"
-BIN="${HYPERSHAPE_BIN:-build/hypershape}"
-PRESETS="${PRESETS:-random2d easy_random2d ood_random2d one_random2d random3d aug_liver liver one_liver}"
-DATA_DIR="${DATA_DIR:-results/gallery}"
-OUT_DIR="${OUT_DIR:-docs/figures}"
+cd "$(dirname "$0")/.."
+: "${HYPERSHAPE_BIN:=build/hypershape}" "${DATA_DIR:=results/gallery}" "${OUT_DIR:=docs/figures}"
+: "${PRESETS:=random2d easy_random2d ood_random2d one_random2d random3d aug_liver liver one_liver}"
+BIN=$HYPERSHAPE_BIN
 export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
 
 [[ -x "$BIN" ]] || { echo "error: no CLI at $BIN (build it, or set HYPERSHAPE_BIN)" >&2; exit 2; }

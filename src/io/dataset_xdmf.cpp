@@ -47,23 +47,17 @@ struct ShapeInfo {
 };
 
 std::vector<ShapeInfo> read_shapes(hid_t file) {
-  Id all{check_id(H5Gopen2(file, "shapes", H5P_DEFAULT), "shapes"), H5Gclose};
-  H5G_info_t info;
-  check(H5Gget_info(all.id, &info), "shapes");
   std::vector<ShapeInfo> shapes;
-  for (hsize_t i = 0; i < info.nlinks; ++i) {
-    char name[64];
-    H5Lget_name_by_idx(all.id, ".", H5_INDEX_NAME, H5_ITER_INC, i, name, sizeof name, H5P_DEFAULT);
-    Id g{check_id(H5Gopen2(all.id, name, H5P_DEFAULT), name), H5Gclose};
-    ShapeInfo s{name, dims_of(g.id, "nodes"), dims_of(g.id, "cells"), dims_of(g.id, "point_cloud/sdf"),
-                dims_of(g.id, "point_cloud/dirichlet_distance"), {}, 0};
-    if (s.nodes.size() != 2 || s.cells.size() != 2) continue;  // a failed shape: nothing to show
+  for_each_group(file, "shapes", [&](const char* name, hid_t g) {
+    ShapeInfo s{name, dims_of(g, "nodes"), dims_of(g, "cells"), dims_of(g, "point_cloud/sdf"),
+                dims_of(g, "point_cloud/dirichlet_distance"), {}, 0};
+    if (s.nodes.size() != 2 || s.cells.size() != 2) return;  // a failed shape: nothing to show
     for (const char* f : kLoadFields) {
-      const auto d = dims_of(g.id, (std::string("loads/") + f).c_str());
+      const auto d = dims_of(g, (std::string("loads/") + f).c_str());
       if (d.size() == 3) s.load_fields[f] = d, s.n_loads = d[0];
     }
     shapes.push_back(std::move(s));
-  }
+  });
   return shapes;
 }
 

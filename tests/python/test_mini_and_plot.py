@@ -24,14 +24,9 @@ import hypershape_data as hd  # noqa: E402
 import hypershape_plot as hp  # noqa: E402
 
 script = os.path.join(src, "scripts", "hypershape_data.py")
-failures = 0
-
-
-def check(cond, what):
-    global failures
-    print(("ok   " if cond else "FAIL ") + what, flush=True)
-    failures += 0 if cond else 1
-    return cond
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import checks  # noqa: E402
+from checks import check  # noqa: E402
 
 
 def run(*args):
@@ -134,8 +129,8 @@ def main():
             check_png(d3, tmp, "p3")
     finally:
         shutil.rmtree(tmp)
-    print(f"{'ok' if failures == 0 else 'FAILED'}: {failures} failures")
-    return 1 if failures else 0
+    print(f"{'ok' if checks.failures == 0 else 'FAILED'}: {checks.failures} failures")
+    return 1 if checks.failures else 0
 
 
 if __name__ == "__main__":

@@ -55,13 +55,13 @@ def main():
         moved = os.path.join(tmp, "elsewhere", "x2d")
         shutil.move(os.path.join(tmp, "x2d"), moved)
         os.chdir(os.path.join(tmp, "elsewhere"))
-        n = xr.failures
+        n = xr.checks.failures
         xr.check_meshio(moved)
-        xr.check(xr.failures == n, "the moved dataset reads the same from another directory")
+        xr.check(xr.checks.failures == n, "the moved dataset reads the same from another directory")
     finally:
         shutil.rmtree(tmp)
-    print(f"{'ok' if xr.failures == 0 else 'FAILED'}: {xr.failures} failures")
-    return 1 if xr.failures else 0
+    print(f"{'ok' if xr.checks.failures == 0 else 'FAILED'}: {xr.checks.failures} failures")
+    return 1 if xr.checks.failures else 0
 
 
 if __name__ == "__main__":

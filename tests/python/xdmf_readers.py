@@ -5,7 +5,7 @@ every array they return with the shards, read by h5py:
     /usr/bin/python3 tests/python/xdmf_readers.py paraview DIR   # xdmf/shard-*.xdmf and shape-*.xdmf,
                                                                  # ParaView's default reader and the legacy one
 
-Each check prints "ok ..." / "FAIL ..." lines and the module's `failures` counts the failures;
+Each check prints "ok ..." / "FAIL ..." lines and the module's `checks.failures` counts the failures;
 the command exits 1 if any failed. What is asserted, per reader and file: the reader's name
 (ParaView's default must be Xdmf3ReaderS), one time step per load case (times 0..L-1), and at
 every time step, for every solved shape, the arrays sdf, dirichlet_distance, dirichlet_mask,
@@ -23,14 +23,9 @@ import numpy as np
 SCALARS = {"sdf": "point_cloud/sdf", "dirichlet_distance": "point_cloud/dirichlet_distance",
            "dirichlet_mask": "dirichlet_mask", "neumann_mask": "neumann_mask"}
 LOAD_FIELDS = ("displacement", "traction")
-failures = 0
-
-
-def check(cond, what):
-    global failures
-    print(("ok   " if cond else "FAIL ") + what, flush=True)
-    failures += 0 if cond else 1
-    return cond
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import checks  # noqa: E402
+from checks import check  # noqa: E402
 
 
 def shard_of(xdmf):
@@ -167,5 +162,5 @@ if __name__ == "__main__":
     which, dataset = sys.argv[1], sys.argv[2]
     check_no_hyperslab(dataset)
     {"meshio": check_meshio, "paraview": check_paraview}[which](dataset)
-    print(f"xdmf_readers {which}: {'ok' if failures == 0 else f'{failures} failures'}")
-    sys.exit(1 if failures else 0)
+    print(f"xdmf_readers {which}: {'ok' if checks.failures == 0 else f'{checks.failures} failures'}")
+    sys.exit(1 if checks.failures else 0)

@@ -25,7 +25,6 @@ for p in range(16917, 17917, 2):
 export SLURM_PORT
 "$src/scripts/slurm/local_cluster.sh" start "$cluster" || { fail "cluster did not start"; finish; exit 1; }
 export SLURM_CONF=$cluster/slurm.conf
-compare() { /usr/bin/python3 "$src/tests/cli/compare_datasets.py" "$@"; }
 
 cat > "$work/slurm.yaml" <<'YAML'
 preset: random2d
