@@ -4,7 +4,8 @@
 ///                                               --targets/--repeat: several load cases (benchmarks)
 ///   hypershape shapes CONFIG.yaml -o SHAPES.h5  random shapes of a dataset config (meshes,
 ///                                               Dirichlet patches, metrics); MPI-parallel
-///   hypershape generate [DATASET.yaml] [-o DIR]  a dataset (default: the embedded small one);
+///   hypershape generate [DATASET.yaml] [-o DIR]  a dataset (default: the embedded small one;
+///                                               --preset NAME: a preset; --mini: a few shapes);
 ///                                               MPI solver groups, SLURM arrays, resume
 ///   hypershape index DIR                        manifest, splits, statistics, XDMF of a dataset
 ///   hypershape effects                          lists the effects a scene may use
@@ -46,12 +47,18 @@ void check_output_path(const std::string& out) {
   if (access(dir.c_str(), W_OK) != 0) throw core::InputError("", "-o", "directory is not writable: " + dir.string());
 }
 
-int run_generate(MPI_Comm comm, const std::string& config_path, const std::string& out,
+/// The dataset `generate` makes: a config file, an embedded preset or the default, maybe --mini.
+config::DatasetConfig dataset_to_generate(const std::string& config_path, const std::string& preset, bool mini) {
+  const config::DatasetConfig cfg =
+      !preset.empty()       ? config::preset_dataset(preset)
+      : config_path.empty() ? config::parse_dataset_text(config::default_dataset_text(), "<default dataset>")
+                            : config::parse_dataset_file(config_path);
+  return mini ? config::mini_dataset(cfg) : cfg;
+}
+
+int run_generate(MPI_Comm comm, const config::DatasetConfig& cfg, const std::string& out,
                  factory::GenerateOptions gen) {
   mesh::GmshSession gmsh;
-  const config::DatasetConfig cfg =
-      config_path.empty() ? config::parse_dataset_text(config::default_dataset_text(), "<default dataset>")
-                          : config::parse_dataset_file(config_path);
   gen.output_dir = out.empty() ? "results/" + cfg.name : out;
   const auto report = factory::generate(comm, cfg, gen);
   core::info(comm, "[generate] done{}:\n{}", report.indexed ? " (dataset complete: manifest, splits, stats written)"
@@ -136,7 +143,15 @@ int run(int argc, char** argv) {
   // SLURM array defaults: the task's offset in the array and the array's size.
   gen.task_index = env_int("SLURM_ARRAY_TASK_ID", 0) - env_int("SLURM_ARRAY_TASK_MIN", 0);
   gen.task_count = env_int("SLURM_ARRAY_TASK_COUNT", 1);
-  generate->add_option("config", gen_config, "dataset config (YAML); default: the embedded small dataset");
+  auto* gen_config_opt =
+      generate->add_option("config", gen_config, "dataset config (YAML); default: the embedded small dataset");
+  std::string gen_preset;
+  bool gen_mini = false;
+  generate->add_option("--preset", gen_preset, "an embedded preset (configs/presets/NAME.yaml) instead of a config")
+      ->excludes(gen_config_opt);
+  generate->add_flag("--mini", gen_mini,
+                     "a few shapes and load cases of it (<= 4 shapes in 2D, 2 in 3D; 2 load cases, 4 for one "
+                     "shape; coarse grids): seconds, for docs and loaders; named NAME_mini");
   generate->add_option("-o,--output", gen_out, "output directory (default: results/<name>)");
   generate->add_option("--task-index", gen.task_index, "this task's slice (default: $SLURM_ARRAY_TASK_ID - $SLURM_ARRAY_TASK_MIN)");
   generate->add_option("--task-count", gen.task_count, "number of slices (default: $SLURM_ARRAY_TASK_COUNT or 1)");
@@ -162,7 +177,7 @@ int run(int argc, char** argv) {
     for (auto& [name, help] : physics::registered_effects()) core::info(comm, "{:20s} {}", name, help);
     return 0;
   }
-  if (*generate) return run_generate(comm, gen_config, gen_out, gen);
+  if (*generate) return run_generate(comm, dataset_to_generate(gen_config, gen_preset, gen_mini), gen_out, gen);
   if (*index) return run_index(comm, index_dir);
   if (*shapes) return run_shapes(comm, shapes_config, shapes_out, first, count);
   // Validate everything that can be validated before any work or output.

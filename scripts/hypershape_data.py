@@ -22,6 +22,9 @@ Command line:
     scripts/hypershape_data.py summary DIR   # counts, splits, statistics, every array's shape
     scripts/hypershape_data.py check DIR     # CRC-32 of every shard against manifest.json, no
                                              # NaN/Inf in any stored array; exit 1 otherwise
+    scripts/hypershape_data.py plot DIR [--shape I ...] [--load J ...] [-o file.png]
+                                             # deformed shapes coloured by |u| (matplotlib,
+                                             # scripts/hypershape_plot.py)
 
 Handles: a Dataset opens one h5py.File per shard, read-only, the first time a shard is read,
 and keeps it until close(). Handles are never shared across processes: a Dataset that finds
@@ -753,6 +756,51 @@ def print_solver_report(r, out=sys.stdout):
         w(f"  failed {k:>5} x  {reason}")
 
 
+def _add_plot_parser(sub):
+    pp = sub.add_parser("plot", help="pictures of solutions: deformed shape coloured by |u|, Dirichlet "
+                                     "patch, load (matplotlib; scripts/hypershape_plot.py)")
+    pp.add_argument("dir")
+    pp.add_argument("--shape", type=int, nargs="+", help="shape ids (default: the first solved shape)")
+    pp.add_argument("--load", type=int, nargs="+", default=[0], help="load case ids (default 0)")
+    pp.add_argument("-o", "--output", help="PNG file (default: shape-I-load-J.png)")
+    pp.add_argument("--cols", type=int, help="panels per row (default: up to 4)")
+    pp.add_argument("--scale", type=float, default=1.0, help="displacement magnification (default 1)")
+    pp.add_argument("--gallery", type=int, metavar="N",
+                    help="instead of --shape/--load: the first N converged load cases, load 0 of each "
+                         "shape first, then load 1, ...")
+
+
+def plot_command(a):
+    """`plot`: one panel per (shape, load case); bad ids stop with the option named, exit 2."""
+    try:
+        ds = open_dataset(a.dir)
+    except (OSError, ValueError, KeyError) as e:
+        print(f"plot: cannot open dataset {a.dir}: {e}", file=sys.stderr)
+        return 2
+    solved = ds.shape_ids()
+    shapes = a.shape if a.shape is not None else solved[:1]
+    bad = [i for i in shapes if i not in solved]
+    if bad or not shapes:
+        print(f"plot: --shape {bad or shapes}: not a solved shape of {a.dir} (solved: "
+              f"{solved[:10]}{' ...' if len(solved) > 10 else ''})", file=sys.stderr)
+        return 2
+    bad = [j for j in a.load if not 0 <= j < ds.n_loads]
+    if bad:
+        print(f"plot: --load {bad}: out of range [0, {ds.n_loads})", file=sys.stderr)
+        return 2
+    pairs = [(i, j) for i in shapes for j in a.load]
+    if a.gallery:
+        pairs = [(i, j) for j in range(ds.n_loads) for i in solved if ds.load_status(i)[j] == 1][: a.gallery]
+    if not pairs:
+        print(f"plot: --gallery: no converged load case in {a.dir}", file=sys.stderr)
+        return 2
+    out = a.output or f"shape-{pairs[0][0]}-load-{pairs[0][1]}.png"
+    import hypershape_plot
+    hypershape_plot.plot(ds, pairs, out, a.cols, a.scale)
+    print(f"plot: {len(pairs)} panel(s) -> {out}")
+    return 0
+
+
 def _main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -762,7 +810,10 @@ def _main(argv=None):
     sp = sub.add_parser("solver", help="convergence rate, failure reasons, Newton and recovery cost")
     sp.add_argument("dir")
     sp.add_argument("--json", help="also write the figures here")
+    _add_plot_parser(sub)
     a = ap.parse_args(argv)
+    if a.command == "plot":
+        return plot_command(a)
     if a.command == "solver":
         r = solver_report(a.dir)
         print_solver_report(r)

@@ -6,7 +6,8 @@
 #
 # For each preset, draws and meshes shapes 0..N-1 with `hypershape shapes` (N = 200 for the 2D
 # presets, 1 for one_random2d, 30 for the 3D presets), then scripts/shape_gallery.py writes
-# docs/figures/<name>_gallery.png (the first 16 shapes) and <name>_histogram.png (all N).
+# docs/figures/<name>_gallery.png (the first 16 shapes) and <name>_histogram.png (all N; none
+# for a single shape, e.g. one_random2d).
 # A preset whose base surface file is missing is skipped with a note (aug_liver's
 # configs/surfaces/organ.stl is made by scripts/make_organ_surface.py). Prints the time of each
 # preset and the total.

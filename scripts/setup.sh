@@ -26,6 +26,7 @@ PACKAGES=(
   libcgal-dev                       # CGAL: AABB trees (distances), self-intersection checks, surface remeshing
   python3-h5py python3-numpy        # Python readers and checks of the output
   python3-matplotlib                # galleries, histograms and plots in the README
+  python3-meshio                    # reads the datasets' XDMF views in a test (tests/python/test_xdmf_views.py)
   python3-torch                     # PyTorch Datasets of the grid and point-cloud forms (scripts/hypershape_torch.py)
 )
 

@@ -15,7 +15,8 @@ For every file (root attribute `name` = NAME) it writes
           is in view); box [-1, 1]^3; title "id, Hausdorff distance to the base".
       A failed shape (attribute failed == 1) is an empty panel labelled "failed".
   OUT_DIR/NAME_histogram.png  the isoperimetric ratio (2D) / the Hausdorff distance to the base
-                              (3D) over ALL non-failed shapes in the file
+                              (3D) over ALL non-failed shapes in the file (not written for one
+                              shape: OneRandom2D)
 
 and prints one summary line per file: shapes, failed, redraws, median/min/max of the metric.
 Needs h5py, numpy and matplotlib (Agg backend, no display).
@@ -247,7 +248,10 @@ def main():
         g = os.path.join(args.out_dir, f"{name}_gallery.png")
         h = os.path.join(args.out_dir, f"{name}_histogram.png")
         gallery(name, dim, shapes, g, n_max)
-        histogram(name, dim, values, h)
+        if values.size > 1:  # a histogram of one shape says nothing
+            histogram(name, dim, values, h)
+        else:
+            h = "no histogram (one shape)"
         mname = "iso ratio" if dim == 2 else "Hausdorff"
         stats = (f"{mname} median {np.median(values):.4f} min {values.min():.4f} "
                  f"max {values.max():.4f}") if values.size else f"{mname}: none"

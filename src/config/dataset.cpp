@@ -419,6 +419,23 @@ DatasetConfig parse_dataset_text(const std::string& text, const std::string& sou
   return c;
 }
 
+DatasetConfig mini_dataset(const DatasetConfig& full) {
+  YAML::Node root = YAML::Load(full.text);
+  const bool one_shape = full.n_shapes == 1;
+  root["name"] = full.name + "_mini";
+  root["shapes"]["count"] = std::min<std::int64_t>(full.n_shapes, full.shapes.dim == 3 ? 2 : 4);
+  root["loads"]["count"] = std::min<long>(full.loads.count, one_shape ? 4 : 2);
+  root["representations"]["grid_size"] = full.shapes.dim == 3 ? 16 : 32;
+  root["output"]["shard_size"] = 2;
+  YAML::Emitter e;
+  e << root;
+  return parse_dataset_text(e.c_str(), full.source + " (--mini)");
+}
+
+DatasetConfig preset_dataset(const std::string& name) {
+  return parse_dataset_text("preset: " + name + "\n", "--preset " + name);
+}
+
 DatasetConfig parse_dataset_file(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw InputError(path, "", "cannot open the dataset config");

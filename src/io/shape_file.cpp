@@ -79,17 +79,8 @@ void write_shapes(const std::string& path, const std::vector<ShapeRecord>& shape
 
 std::vector<ShapeRecord> read_shapes(const std::string& path) {
   Id file{check_id(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), "open " + path), H5Fclose};
-  Id all{check_id(H5Gopen2(file.id, "shapes", H5P_DEFAULT), "shapes"), H5Gclose};
-  H5G_info_t info;
-  check(H5Gget_info(all.id, &info), "shapes");
   std::vector<ShapeRecord> out;
-  for (hsize_t i = 0; i < info.nlinks; ++i) {
-    char name[64];
-    H5Lget_name_by_idx(all.id, ".", H5_INDEX_NAME, H5_ITER_INC, i, name, sizeof name, H5P_DEFAULT);
-    Id g{check_id(H5Gopen2(all.id, name, H5P_DEFAULT), name), H5Gclose};
-    ShapeRecord s = read_shape_group(g.id);
-    out.push_back(std::move(s));
-  }
+  for_each_group(file.id, "shapes", [&](const char*, hid_t g) { out.push_back(read_shape_group(g)); });
   return out;
 }
 

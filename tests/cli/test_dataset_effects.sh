@@ -13,7 +13,6 @@
 #  - bad scenes stop before any work: exit code 2, the key path named, nothing written.
 # Needs HYPERSHAPE_BIN and HYPERSHAPE_SOURCE_DIR (set by CTest).
 . "$(dirname "$0")/lib.sh"
-compare() { /usr/bin/python3 "$src/tests/cli/compare_datasets.py" "$@"; }
 export PYTHONPATH="$src/scripts${PYTHONPATH:+:$PYTHONPATH}"
 
 sed -e 's/shapes: {count: 4, h: 0.08}/shapes: {count: 3, h: 0.1}/; s/count: 4, target/count: 2, target/' \

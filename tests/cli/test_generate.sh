@@ -10,7 +10,6 @@
 #    file, a broken one, too few files for count, on the wrong base, in 2D).
 # Needs HYPERSHAPE_BIN and HYPERSHAPE_SOURCE_DIR (set by CTest).
 . "$(dirname "$0")/lib.sh"
-compare() { /usr/bin/python3 "$src/tests/cli/compare_datasets.py" "$@"; }
 
 cat > "$work/tiny.yaml" <<'YAML'
 preset: random2d

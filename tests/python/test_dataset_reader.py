@@ -26,14 +26,9 @@ script = os.path.join(src, "scripts", "hypershape_data.py")
 sys.path.insert(0, os.path.join(src, "scripts"))
 import hypershape_data as hd  # noqa: E402
 
-failures = 0
-
-
-def check(cond, what):
-    global failures
-    print(("ok   " if cond else "FAIL ") + what, flush=True)
-    failures += 0 if cond else 1
-    return cond
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import checks  # noqa: E402
+from checks import check  # noqa: E402
 
 
 CONFIGS = {
@@ -378,5 +373,5 @@ with tempfile.TemporaryDirectory() as work:
         torch_part([paths["t2d"], paths["t3d"]])
         cli(paths["t2d"], work)
 
-print("all checks passed" if not failures else f"{failures} checks failed")
-sys.exit(1 if failures else 0)
+print("all checks passed" if not checks.failures else f"{checks.failures} checks failed")
+sys.exit(1 if checks.failures else 0)

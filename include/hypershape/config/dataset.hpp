@@ -126,4 +126,13 @@ DatasetConfig parse_dataset_text(const std::string& text, const std::string& sou
 /// The embedded default dataset: a small Random2D slice (a minute on a laptop).
 const char* default_dataset_text();
 
+/// The "mini" version of a parsed config (`hypershape generate --mini`), for docs, galleries and
+/// loaders: name + "_mini", at most 4 shapes in 2D and 2 in 3D, 2 load cases per shape (4 when
+/// the config has a single shape), grids of 32 (2D) / 16 (3D) points per axis, shards of 2
+/// shapes; everything else (family, mesh, element, effects, seed) as configured, so shape i of
+/// the mini dataset is shape i of the full one. Not collective. Throws core::InputError.
+DatasetConfig mini_dataset(const DatasetConfig& full);
+/// The config `preset: NAME` alone (`hypershape generate --preset NAME`).
+DatasetConfig preset_dataset(const std::string& name);
+
 }  // namespace hypershape::config
