@@ -52,6 +52,9 @@ BUILD_TYPE=${BUILD_TYPE:-Release}
 if [ ! -f "$BUILD_DIR/CMakeCache.txt" ]; then
   cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE="$BUILD_TYPE" >/dev/null
 fi
-cmake --build "$BUILD_DIR" -j "$(nproc)" 2>&1 | grep -v "^\[ *[0-9]*%\]" || true
-test "${PIPESTATUS[0]}" -eq 0
+# (pipefail: a failed build fails here; grep alone may find nothing to print)
+if ! cmake --build "$BUILD_DIR" -j "$(getconf _NPROCESSORS_ONLN)" 2>&1 | { grep -v "^\[ *[0-9]*%\]" || true; }; then
+  echo "[setup] the build failed (messages above)" >&2
+  exit 1
+fi
 echo "[setup] build ready in $BUILD_DIR"

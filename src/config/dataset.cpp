@@ -182,7 +182,7 @@ physics::SceneSpec shorthand_scene(const DatasetConfig& c, const std::string& so
   physics::SceneSpec s;
   s.source = source;
   auto add = [&](const char* name, std::map<std::string, physics::ParamValue> params) {
-    s.effects.push_back({name, name, std::string("effects.") + name, std::move(params), true, false});
+    s.effects.push_back({name, name, std::string("effects.") + name, std::move(params), true, false, {}, 0});
   };
   add("neo_hookean", {{"E", c.material.E}, {"nu", c.material.nu}});
   if (c.shapes.dirichlet_radius > 0) add("dirichlet_patch", {{"radius", c.shapes.dirichlet_radius}});

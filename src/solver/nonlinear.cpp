@@ -582,13 +582,17 @@ void NonlinearSolver::switch_branch(double target, double start, int attempt, Ta
   if (ok) {
     ++its;
     softest_mode();
-    const double eps = 0.05 * target;
     HS_PETSC(VecCopy(u_, backup_));
     double e[2];
-    bool adm[2];
-    for (int k = 0; k < 2; ++k) {
-      HS_PETSC(VecWAXPY(w_, k == 0 ? eps : -eps, v_, backup_));
-      adm[k] = problem_.energy(w_, s_, e[k]);
+    bool adm[2] = {false, false};
+    double eps = 0.05 * target;
+    // Shorter where both directions invert an element (a state already near inversion).
+    for (int tries = 0;; ++tries, eps *= 0.25) {
+      for (int k = 0; k < 2; ++k) {
+        HS_PETSC(VecWAXPY(w_, k == 0 ? eps : -eps, v_, backup_));
+        adm[k] = problem_.energy(w_, s_, e[k]);
+      }
+      if (adm[0] || adm[1] || tries == 3) break;
     }
     const int pick = adm[0] && (!adm[1] || e[0] <= e[1]) ? 0 : 1;
     ok = adm[pick];
