@@ -8,6 +8,7 @@
 #include <string>
 
 #include "hypershape/core/error.hpp"
+#include "hypershape/core/vec_array.hpp"
 
 namespace hypershape::solver {
 
@@ -248,23 +249,17 @@ bool LdltFactor::solve(Vec b, Vec x) {
     HS_PETSC(KSPGetConvergedReason(ksp_, &r));
     return r > 0;
   }
-  const PetscScalar* bv;
-  PetscScalar* pv;
-  HS_PETSC(VecGetArrayRead(b, &bv));
-  HS_PETSC(VecGetArray(xp_, &pv));
-  for (std::size_t i = 0; i < old_of_new_.size(); ++i) pv[i] = bv[old_of_new_[i]];
-  HS_PETSC(VecRestoreArray(xp_, &pv));
-  HS_PETSC(VecRestoreArrayRead(b, &bv));
+  {
+    core::VecArray<const PetscScalar> bv(b);
+    core::VecArray<PetscScalar> pv(xp_);
+    for (std::size_t i = 0; i < old_of_new_.size(); ++i) pv[PetscInt(i)] = bv[old_of_new_[i]];
+  }
   HS_PETSC(KSPSolve(ksp_, xp_, yp_));
   HS_PETSC(KSPGetConvergedReason(ksp_, &r));
   if (r > 0) refine();
-  const PetscScalar* yv;
-  PetscScalar* xv;
-  HS_PETSC(VecGetArrayRead(yp_, &yv));
-  HS_PETSC(VecGetArray(x, &xv));
-  for (std::size_t i = 0; i < old_of_new_.size(); ++i) xv[old_of_new_[i]] = yv[i];
-  HS_PETSC(VecRestoreArray(x, &xv));
-  HS_PETSC(VecRestoreArrayRead(yp_, &yv));
+  core::VecArray<const PetscScalar> yv(yp_);
+  core::VecArray<PetscScalar> xv(x);
+  for (std::size_t i = 0; i < old_of_new_.size(); ++i) xv[old_of_new_[i]] = yv[PetscInt(i)];
   return r > 0;
 }
 

@@ -1,6 +1,7 @@
 #include "hypershape/solver/nonlinear.hpp"
 
 #include "hypershape/core/timer.hpp"
+#include "hypershape/core/vec_array.hpp"
 #include <petscmat.h>
 
 #include <algorithm>
@@ -325,8 +326,7 @@ double NonlinearSolver::control_direction(Vec u, Vec fallback, Vec c) {
   auto largest = [&](Vec v, PetscInt& offset, double& norm2) {
     HS_PETSC(VecSet(ul, 0.0));
     HS_PETSC(DMGlobalToLocal(dm, v, INSERT_VALUES, ul));
-    const PetscScalar* a;
-    HS_PETSC(VecGetArrayRead(ul, &a));
+    core::VecArray<const PetscScalar> a(ul);
     double best = -1;
     std::int64_t id = INT64_MAX;
     offset = -1;
@@ -335,7 +335,6 @@ double NonlinearSolver::control_direction(Vec u, Vec fallback, Vec c) {
       for (int i = 0; i < dim; ++i) s += a[n.offset + i] * a[n.offset + i];
       if (s > best || (s == best && n.canonical < id)) best = s, id = n.canonical, offset = n.offset;
     }
-    HS_PETSC(VecRestoreArrayRead(ul, &a));
     double gbest = best;
     MPI_Allreduce(MPI_IN_PLACE, &gbest, 1, MPI_DOUBLE, MPI_MAX, comm);
     std::int64_t gid = best == gbest ? id : INT64_MAX;
@@ -350,13 +349,9 @@ double NonlinearSolver::control_direction(Vec u, Vec fallback, Vec c) {
   const double m = std::sqrt(std::max(m2, 0.0));
   HS_PETSC(VecSet(cl, 0.0));
   if (off >= 0 && m > 0) {  // ul still holds the vector the node was picked from
-    const PetscScalar* a;
-    PetscScalar* cv;
-    HS_PETSC(VecGetArrayRead(ul, &a));
-    HS_PETSC(VecGetArray(cl, &cv));
+    core::VecArray<const PetscScalar> a(ul);
+    core::VecArray<PetscScalar> cv(cl);
     for (int i = 0; i < dim; ++i) cv[off + i] = a[off + i] / m;
-    HS_PETSC(VecRestoreArray(cl, &cv));
-    HS_PETSC(VecRestoreArrayRead(ul, &a));
   }
   HS_PETSC(DMLocalToGlobal(dm, cl, INSERT_VALUES, c));  // owned entries only
   HS_PETSC(DMRestoreLocalVector(dm, &cl));
@@ -452,17 +447,17 @@ double NonlinearSolver::softest_mode() {
   Vec xl;
   HS_PETSC(DMGetLocalVector(dm, &xl));
   HS_PETSC(VecSet(xl, 0.0));
-  PetscScalar* x;
-  HS_PETSC(VecGetArray(xl, &x));
-  for (const auto& n : problem_.space().owned_nodes())
-    for (int i = 0; i < dim; ++i) {
-      std::uint64_t h = std::uint64_t(n.canonical) * 0x9E3779B97F4A7C15ull + std::uint64_t(i + 1);
-      h ^= h >> 31;
-      h *= 0xBF58476D1CE4E5B9ull;
-      h ^= h >> 29;
-      x[n.offset + i] = double(h >> 11) / double(1ull << 53) - 0.5;
-    }
-  HS_PETSC(VecRestoreArray(xl, &x));
+  {
+    core::VecArray<PetscScalar> x(xl);
+    for (const auto& n : problem_.space().owned_nodes())
+      for (int i = 0; i < dim; ++i) {
+        std::uint64_t h = std::uint64_t(n.canonical) * 0x9E3779B97F4A7C15ull + std::uint64_t(i + 1);
+        h ^= h >> 31;
+        h *= 0xBF58476D1CE4E5B9ull;
+        h ^= h >> 29;
+        x[n.offset + i] = double(h >> 11) / double(1ull << 53) - 0.5;
+      }
+  }
   HS_PETSC(DMLocalToGlobal(dm, xl, INSERT_VALUES, v_));
   HS_PETSC(DMRestoreLocalVector(dm, &xl));
   for (int k = 0; k < 8; ++k) {  // K is factored (factorise_here): 8 back-substitutions
