@@ -12,6 +12,7 @@
 /// PETSc options (-snes_monitor, -pc_type ..., -log_view) pass through to PETSc.
 #include <CLI/CLI.hpp>
 
+#include <cctype>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -23,6 +24,7 @@
 #include "hypershape/core/log.hpp"
 #include "hypershape/core/petsc_handle.hpp"
 #include "hypershape/core/collective.hpp"
+#include "hypershape/core/interrupt.hpp"
 #include "hypershape/factory/dataset_index.hpp"
 #include "hypershape/factory/generate.hpp"
 #include "hypershape/factory/shape_set.hpp"
@@ -44,6 +46,28 @@ void check_output_path(const std::string& out) {
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) throw core::InputError("", "-o", "directory does not exist: " + dir.string());
   if (access(dir.c_str(), W_OK) != 0) throw core::InputError("", "-o", "directory is not writable: " + dir.string());
+}
+
+/// The PETSc option names among the arguments CLI11 left (`-name [value]`); anything else is
+/// an input error (a misspelt `--option`, a stray word), named before any work.
+std::vector<std::string> petsc_option_names(const std::vector<std::string>& extras) {
+  std::vector<std::string> names;
+  bool value_allowed = false;
+  for (const auto& a : extras) {
+    const bool number = !a.empty() && (std::isdigit(static_cast<unsigned char>(a[0])) || a[0] == '.' ||
+                                       (a.size() > 1 && a[0] == '-' && (std::isdigit(static_cast<unsigned char>(a[1])) || a[1] == '.')));
+    if (a.rfind("--", 0) == 0)
+      throw core::InputError("", a, "unknown option of `hypershape generate` (see --help; PETSc options take one dash)");
+    if (a.size() > 1 && a[0] == '-' && !number) {
+      names.push_back(a);
+      value_allowed = true;
+    } else if (value_allowed) {
+      value_allowed = false;  // the value of the PETSc option before it
+    } else {
+      throw core::InputError("", a, "unexpected argument of `hypershape generate` (one config file; see --help)");
+    }
+  }
+  return names;
 }
 
 int run_generate(MPI_Comm comm, const std::string& config_path, const std::string& out,
@@ -101,6 +125,7 @@ int run(int argc, char** argv) {
   const int rank = core::rank(comm);
   CLI::App app{"hypershape: hyperelastic finite-element data factory"};
   app.allow_extras();  // PETSc options
+  app.fallthrough();   // -q after the subcommand too
   app.require_subcommand(1);
   bool quiet = false;
   app.add_flag("-q,--quiet", quiet, "print only errors");
@@ -142,6 +167,7 @@ int run(int argc, char** argv) {
   generate->add_option("--task-count", gen.task_count, "number of slices (default: $SLURM_ARRAY_TASK_COUNT or 1)");
   generate->add_option("--group-size", gen.group_size, "ranks per shape (default 1)");
   generate->add_option("--progress", gen.progress_seconds, "seconds between progress lines (0: none)");
+  generate->add_flag("--force", gen.force, "write a dataset above the size bound (1 TB) or the free disk space");
   generate->allow_extras();
   auto* index = app.add_subcommand("index", "write the manifest, splits, statistics and XDMF of a dataset directory");
   std::string index_dir;
@@ -162,8 +188,14 @@ int run(int argc, char** argv) {
     for (auto& [name, help] : physics::registered_effects()) core::info(comm, "{:20s} {}", name, help);
     return 0;
   }
-  if (*generate) return run_generate(comm, gen_config, gen_out, gen);
-  if (*index) return run_index(comm, index_dir);
+  if (*generate) {
+    gen.petsc_command_line = petsc_option_names(generate->remaining());
+    return run_generate(comm, gen_config, gen_out, gen);
+  }
+  if (*index) {
+    core::install_interrupt_handlers("index", rank);  // a manifest being replaced is removed
+    return run_index(comm, index_dir);
+  }
   if (*shapes) return run_shapes(comm, shapes_config, shapes_out, first, count);
   // Validate everything that can be validated before any work or output.
   check_output_path(out);

@@ -8,7 +8,10 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <csignal>
 #include <filesystem>
+#include <regex>
+#include <sstream>
 #include <thread>
 
 #include "hypershape/config/scene.hpp"
@@ -16,7 +19,11 @@
 #include "hypershape/core/error.hpp"
 #include "hypershape/core/log.hpp"
 #include "hypershape/core/timer.hpp"
+#include "hypershape/core/interrupt.hpp"
 #include "hypershape/factory/dataset_index.hpp"
+#include "hypershape/factory/output_lock.hpp"
+#include "hypershape/factory/preflight.hpp"
+#include "hypershape/factory/shard_record.hpp"
 #include "hypershape/factory/shape_job.hpp"
 #include "hypershape/factory/shape_pipeline.hpp"
 #include "hypershape/factory/shape_set.hpp"
@@ -85,48 +92,144 @@ std::map<std::string, std::string> software_versions() {
   return {{"petsc", petsc}, {"gmsh", gmsh_version}};
 }
 
-/// Output checks and the shards this task still has to write (rank 0; throws InputError).
-std::vector<std::int64_t> prepare_output(const config::DatasetConfig& cfg, const GenerateOptions& opt,
-                                         std::int64_t n_shards, std::int64_t& done_before) {
-  const fs::path out(opt.output_dir);
-  const std::string key = "-o";
-  std::error_code ec;
-  if (fs::exists(out, ec) && !fs::is_directory(out, ec))
-    throw core::InputError("", key, "output exists and is not a directory: " + out.string());
-  const fs::path yaml = out / "dataset.yaml";
-  if (fs::exists(yaml)) {
-    if (read_text(yaml) != cfg.text)
-      throw core::InputError("", key,
-                             out.string() + " holds another dataset (its dataset.yaml differs from this "
-                             "config); use another output directory");
-  }
-  fs::create_directories(out / "shards", ec);
-  if (ec || access(out.c_str(), W_OK) != 0 || access((out / "shards").c_str(), W_OK) != 0)
-    throw core::InputError("", key, "cannot create or write the output directory " + out.string() +
-                                        (ec ? ": " + ec.message() : ""));
-  fs::create_directories(out / "reports", ec);
-  if (!fs::exists(yaml)) write_atomically(yaml, cfg.text);
-
-  const std::string hash = io::text_digest(cfg.text);
+/// What rank 0 found and holds in the output directory.
+struct OutputState {
+  std::unique_ptr<OutputLock> lock;  ///< rank 0 only
+  std::string text, hash;            ///< dataset.yaml's text (stored in shards), the identity
   std::vector<std::int64_t> todo;
-  for (std::int64_t k = opt.task_index; k < n_shards; k += opt.task_count) {
-    const fs::path p = out / "shards" / shard_name(k);
-    fs::remove(p.string() + ".tmp", ec);  // a kill left it: this task owns shard k
-    if (io::is_complete_shard(p.string(), hash)) {
-      ++done_before;
-      continue;
+  std::int64_t done_before = 0;
+};
+
+void broadcast_text(MPI_Comm comm, std::string& s) {
+  int n = int(s.size());
+  MPI_Bcast(&n, 1, MPI_INT, 0, comm);
+  s.resize(std::size_t(n));
+  MPI_Bcast(s.data(), n, MPI_CHAR, 0, comm);
+}
+
+/// Everything but the lock, from rank 0 to all. Collective.
+void broadcast_output(MPI_Comm comm, OutputState& st) {
+  broadcast_text(comm, st.text);
+  broadcast_text(comm, st.hash);
+  std::int64_t n = std::int64_t(st.todo.size());
+  MPI_Bcast(&n, 1, MPI_INT64_T, 0, comm);
+  st.todo.resize(std::size_t(n));
+  MPI_Bcast(st.todo.data(), int(n), MPI_INT64_T, 0, comm);
+  MPI_Bcast(&st.done_before, 1, MPI_INT64_T, 0, comm);
+}
+
+/// The first line where two canonical texts differ, for the "another dataset" message.
+std::string first_difference(const std::string& a, const std::string& b) {
+  std::istringstream sa(a), sb(b);
+  std::string la, lb;
+  while (true) {
+    const bool ga = bool(std::getline(sa, la)), gb = bool(std::getline(sb, lb));
+    if (!ga && !gb) return "";
+    if (la != lb || ga != gb) return fmt::format("'{}' there, '{}' here", ga ? la : "", gb ? lb : "");
+  }
+}
+
+bool any_shard(const fs::path& out) {
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(out / "shards", ec))
+    if (e.path().extension() == ".h5") return true;
+  return false;
+}
+
+/// The text stored with the data: the existing dataset.yaml when it holds this dataset (the
+/// same meaning, whatever its layout), else this config's (nothing there yet, or what a start
+/// on a full disk left: an empty or unparsable dataset.yaml and no shard). Throws InputError
+/// for another dataset. Reads only.
+std::string dataset_text(const config::DatasetConfig& cfg, const fs::path& out) {
+  const fs::path yaml = out / "dataset.yaml";
+  std::error_code ec;
+  if (!fs::exists(yaml, ec)) return cfg.text;
+  const std::string there = read_text(yaml);
+  std::string meaning;
+  try {
+    meaning = config::canonical_text(config::parse_dataset_text(there, yaml.string(), out.string()));
+  } catch (const std::exception& e) {
+    if (!any_shard(out)) return cfg.text;  // a start that failed before any shard
+    throw core::InputError("", "-o", fmt::format("{} is not a dataset config ({}), and {} holds shards: repair "
+                                                 "or remove it, or use another output directory",
+                                                 yaml.string(), e.what(), (out / "shards").string()));
+  }
+  const std::string mine = config::canonical_text(cfg);
+  if (meaning != mine)
+    throw core::InputError("", "-o", fmt::format("{} holds another dataset (its dataset.yaml means something else: "
+                                                 "{}); use another output directory", out.string(),
+                                                 first_difference(meaning, mine)));
+  return there;
+}
+
+/// Removes what interrupted runs left: this task's shard temporaries, and atomic-write
+/// temporaries (`NAME.tmp-PID`) of processes that no longer run on this host.
+void remove_leftovers(const fs::path& out, const GenerateOptions& opt, std::int64_t n_shards) {
+  std::error_code ec;
+  for (std::int64_t k = opt.task_index; k < n_shards; k += opt.task_count)
+    fs::remove((out / "shards" / shard_name(k)).string() + ".tmp", ec);
+  static const std::regex tmp(R"(.*\.tmp-(\d+))");
+  for (const auto& sub : {out, out / "reports", out / "records"})
+    for (const auto& e : fs::directory_iterator(sub, ec)) {
+      std::smatch m;
+      const std::string f = e.path().filename().string();
+      if (std::regex_match(f, m, tmp) && ::kill(pid_t(std::stol(m[1])), 0) != 0 && errno == ESRCH)
+        fs::remove(e.path(), ec);
     }
-    fs::remove(p, ec);  // damaged (should not happen: shards appear by rename)
+}
+
+/// This task's shards still to write: absent ones, and those on disk that fail verification
+/// (removed here, with a line saying why).
+std::vector<std::int64_t> shards_to_do(const config::DatasetConfig& cfg, const GenerateOptions& opt,
+                                       const std::string& hash, std::int64_t n_shards, std::int64_t& done_before) {
+  std::vector<std::int64_t> todo;
+  std::error_code ec;
+  for (std::int64_t k = opt.task_index; k < n_shards; k += opt.task_count) {
+    const fs::path p = fs::path(opt.output_dir) / "shards" / shard_name(k);
+    if (fs::exists(p, ec)) {
+      const std::string problem = shard_problem(opt.output_dir, shard_identity(cfg, hash, k));
+      if (problem.empty()) {
+        ++done_before;
+        continue;
+      }
+      core::log_line(MPI_COMM_SELF, core::Verbosity::quiet,
+                     fmt::format("[generate] {}: {}: redoing it", p.string(), problem));
+      fs::remove(p, ec);
+    }
+    fs::remove(record_path(opt.output_dir, k), ec);
     todo.push_back(k);
   }
   return todo;
 }
 
-std::string format_duration(double s) {
-  if (!std::isfinite(s) || s < 0) return "?";
-  const long t = long(s + 0.5);
-  return t >= 3600 ? fmt::format("{}h{:02d}m", t / 3600, (t % 3600) / 60)
-                   : fmt::format("{}m{:02d}s", t / 60, t % 60);
+/// Rank 0's side of the output: checks (path, identity, size and free space) before anything is
+/// written, then the directory, the lock, dataset.yaml, and the shards this task still has to
+/// write. Throws InputError.
+OutputState open_output(const config::DatasetConfig& cfg, const GenerateOptions& opt, const DatasetEstimate& est,
+                        std::int64_t n_shards) {
+  const fs::path out(opt.output_dir);
+  std::error_code ec;
+  if (fs::exists(out, ec) && !fs::is_directory(out, ec))
+    throw core::InputError("", "-o", "output exists and is not a directory: " + out.string());
+  OutputState st;
+  st.text = dataset_text(cfg, out);
+  std::int64_t missing = 0;
+  for (std::int64_t k = opt.task_index; k < n_shards; k += opt.task_count)
+    missing += fs::exists(out / "shards" / shard_name(k), ec) ? 0 : shapes_in_shard(cfg, k);
+  check_resources(cfg, est, est.bytes_per_shape * double(missing), opt.output_dir, opt.force);
+  fs::create_directories(out / "shards", ec);
+  if (ec || access(out.c_str(), W_OK) != 0 || access((out / "shards").c_str(), W_OK) != 0)
+    throw core::InputError("", "-o", "cannot create or write the output directory " + out.string() +
+                                         (ec ? ": " + ec.message() : ""));
+  fs::create_directories(out / "reports", ec);
+  st.lock = std::make_unique<OutputLock>(opt.output_dir, opt.task_index, opt.task_count);
+  if (!st.lock->note().empty()) core::log_line(MPI_COMM_SELF, core::Verbosity::normal, "[generate] " + st.lock->note());
+  st.text = dataset_text(cfg, out);  // again, under the lock
+  if (st.text == cfg.text && read_text(out / "dataset.yaml") != cfg.text) write_atomically(out / "dataset.yaml", cfg.text);
+  remove_leftovers(out, opt, n_shards);
+  st.hash = config_hash(cfg);
+  st.todo = shards_to_do(cfg, opt, st.hash, n_shards, st.done_before);
+  return st;
 }
 
 }  // namespace
@@ -144,20 +247,20 @@ RunReport generate(MPI_Comm comm, const config::DatasetConfig& cfg, const Genera
   RunReport rep;
   const std::int64_t S = cfg.shard_size;
   rep.shards_total = (cfg.n_shapes + S - 1) / S;
-  std::vector<std::int64_t> todo;
-  std::int64_t done_before = 0;
-  // The base surface is read (and so checked) before anything is written.
+  // Everything is checked before anything is written: the base surface (read), the PETSc
+  // options (a trial solve), then on rank 0 the output, the identity and the free space.
   const std::optional<geometry::Boundary> base = load_dataset_base(cfg);
-  core::on_root(comm, [&] { todo = prepare_output(cfg, opt, rep.shards_total, done_before); });
-  {
-    std::int64_t n = std::int64_t(todo.size());
-    MPI_Bcast(&n, 1, MPI_INT64_T, 0, comm);
-    todo.resize(std::size_t(n));
-    MPI_Bcast(todo.data(), int(n), MPI_INT64_T, 0, comm);
-    MPI_Bcast(&done_before, 1, MPI_INT64_T, 0, comm);
-  }
+  check_petsc_options(cfg, user_options(cfg, opt.petsc_command_line));
+  const DatasetEstimate est = estimate_dataset(cfg);
+  core::info(comm, "[generate] estimate: about {} on disk and {} of CPU for the whole dataset (rough: ~{:.0f} nodes "
+             "per shape)", format_bytes(est.bytes), format_duration(est.cpu_seconds), est.nodes_per_shape);
+  OutputState out;
+  core::on_root(comm, [&] { out = open_output(cfg, opt, est, rep.shards_total); });
+  core::install_interrupt_handlers("generate", rank);
+  broadcast_output(comm, out);
+  std::vector<std::int64_t>& todo = out.todo;
+  const std::int64_t done_before = out.done_before;
   rep.shards_done_before = done_before;
-  solver::set_default_options(cfg.petsc);
   HS_PETSC(PetscLogDefaultBegin());
 
   std::int64_t todo_shapes = 0;
@@ -173,7 +276,7 @@ RunReport generate(MPI_Comm comm, const config::DatasetConfig& cfg, const Genera
   int grank = 0;
   MPI_Comm_rank(group, &grank);
   const bool group_root = grank == 0;
-  const std::string hash = io::text_digest(cfg.text);
+  const std::string& hash = out.hash;
   const auto software = software_versions();
 
   core::PhaseTimes times;
@@ -206,7 +309,7 @@ RunReport generate(MPI_Comm comm, const config::DatasetConfig& cfg, const Genera
       if (group_root) {
         io::ShardHeader h;
         h.dataset_name = cfg.name;
-        h.config_text = cfg.text;
+        h.config_text = out.text;
         h.scene_text = config::effects_yaml(cfg.scene);
         h.config_hash = hash;
         h.seed = cfg.seed;
@@ -247,7 +350,9 @@ RunReport generate(MPI_Comm comm, const config::DatasetConfig& cfg, const Genera
       }
       if (group_root) {
         auto t = times.scope("io");
-        writer->commit();
+        writer->commit([&](std::uint32_t crc, std::uint64_t bytes) {
+          write_shard_record(opt.output_dir, shard_identity(cfg, hash, k), crc, bytes);
+        });
         ++shards_written;
       }
     }
@@ -348,6 +453,7 @@ RunReport generate(MPI_Comm comm, const config::DatasetConfig& cfg, const Genera
   });
   MPI_Bcast(&complete, 1, MPI_INT, 0, comm);
   rep.indexed = complete == 1;
+  core::remove_interrupt_handlers();
   return rep;
 }
 
