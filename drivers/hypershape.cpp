@@ -29,6 +29,7 @@
 #include "hypershape/factory/generate.hpp"
 #include "hypershape/factory/shape_set.hpp"
 #include "hypershape/factory/solve_scene.hpp"
+#include "hypershape/io/dataset_shard.hpp"
 #include "hypershape/io/shape_file.hpp"
 #include "hypershape/mesh/gmsh_mesher.hpp"
 #include "hypershape/physics/registry.hpp"
@@ -189,7 +190,7 @@ int run(int argc, char** argv) {
     return 0;
   }
   if (*generate) {
-    gen.petsc_command_line = petsc_option_names(generate->remaining());
+    gen.petsc_command_line = petsc_option_names(app.remaining(true));
     return run_generate(comm, gen_config, gen_out, gen);
   }
   if (*index) {
@@ -221,6 +222,13 @@ int main(int argc, char** argv) {
     // Input errors are raised on every rank alike: report once.
     if (core::rank(PETSC_COMM_WORLD) == 0) std::fprintf(stderr, "error: %s\n", e.what());
     code = 2;
+  } catch (const io::StorageError& e) {
+    // The shard's temporary file is gone; HDF5 may still hold it and crash in its shutdown
+    // (PetscFinalize -> MPI_Finalize -> HDF5): end here, with the message, the status and no crash.
+    std::fprintf(stderr, "[rank %d] error: %s\n", core::rank(PETSC_COMM_WORLD), e.what());
+    std::fflush(nullptr);
+    if (core::size(PETSC_COMM_WORLD) > 1) MPI_Abort(PETSC_COMM_WORLD, 1);
+    std::_Exit(1);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "[rank %d] error: %s\n", core::rank(PETSC_COMM_WORLD), e.what());
     code = 1;

@@ -307,6 +307,7 @@ RunReport generate(MPI_Comm comm, const config::DatasetConfig& cfg, const Genera
       const std::int64_t first = k * S, n = std::min(S, cfg.n_shapes - first);
       std::unique_ptr<io::ShardWriter> writer;
       if (group_root) {
+        check_shard_space(opt.output_dir, k, est.bytes_per_shape * double(n));
         io::ShardHeader h;
         h.dataset_name = cfg.name;
         h.config_text = out.text;

@@ -68,8 +68,11 @@ OutputLock::OutputLock(const std::string& dir, int task_index, int task_count) {
   fd_ = try_lock(path_, true);
   if (fd_ < 0) refuse(dir, holder(path_), "");
   if (left_behind) note_ += fmt::format("took over the stale lock {} ({})\n", mine, holder(path_));
+  char since[32];
+  const std::time_t now = std::time(nullptr);
+  std::strftime(since, sizeof since, "%Y-%m-%d %H:%M:%S UTC", std::gmtime(&now));
   const std::string me = fmt::format("host {}, pid {}, task {} of {}, since {}\n", host_name(), ::getpid(),
-                                     task_index, task_count, std::time(nullptr));
+                                     task_index, task_count, since);
   if (::ftruncate(fd_, 0) != 0 || ::pwrite(fd_, me.data(), me.size(), 0) != ssize_t(me.size())) {
     // A lock we cannot describe still excludes others; the disk may be full (reported later).
   }

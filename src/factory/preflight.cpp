@@ -8,9 +8,7 @@
 #include <filesystem>
 
 #include "hypershape/core/error.hpp"
-#include "hypershape/factory/dataset_scene.hpp"
-#include "hypershape/mesh/gmsh_mesher.hpp"
-#include "hypershape/solver/nonlinear.hpp"
+#include "hypershape/io/dataset_shard.hpp"
 
 namespace hypershape::factory {
 
@@ -87,6 +85,15 @@ void check_resources(const config::DatasetConfig& cfg, const DatasetEstimate& e,
                            fmt::format("{}; {} still to write, but the file system of {} has {} free: free space, "
                                        "choose another -o, or {}", what, format_bytes(bytes_to_write), output_dir,
                                        format_bytes(avail), remedy));
+}
+
+void check_shard_space(const std::string& output_dir, std::int64_t shard, double shard_bytes) {
+  const double avail = free_bytes(output_dir);
+  if (avail < 0.5 * shard_bytes)
+    throw io::StorageError(fmt::format("stopped before shard {}: the file system of {} has {} free, a shard takes "
+                                       "about {}; the shards written before are complete: free space and run the "
+                                       "same command again to resume", shard, output_dir, format_bytes(avail),
+                                       format_bytes(shard_bytes)));
 }
 
 std::vector<UserOption> user_options(const config::DatasetConfig& cfg, const std::vector<std::string>& command_line) {

@@ -60,7 +60,7 @@ void check_petsc_options(const config::DatasetConfig& cfg, const std::vector<Use
   PetscPopErrorHandler();
   for (const auto& o : options) {
     PetscBool used = PETSC_FALSE;
-    HS_PETSC(PetscOptionsUsed(nullptr, o.name.c_str(), &used));
+    HS_PETSC(PetscOptionsUsed(nullptr, o.name.c_str() + 1, &used));  // stored without the dash
     if (!used)
       throw core::InputError(o.origin == "command line" ? "" : cfg.source, o.origin,
                              fmt::format("{}: no PETSc object of this run reads this option (a trial set-up and "

@@ -116,7 +116,7 @@ struct ShardWriter::Impl {
   ~Impl() { core::unregister_temporary(slot); }
   /// Closes what is open and removes the temporary file, whatever state HDF5 is in.
   void abandon();
-  /// abandon(), then throws std::runtime_error naming the file, `e` and the free space.
+  /// abandon(), then throws StorageError naming the file, `e` and the free space.
   [[noreturn]] void fail(const std::exception& e);
 };
 
@@ -207,9 +207,9 @@ void ShardWriter::Impl::fail(const std::exception& e) {
   struct statvfs v {};
   const std::string dir = fs::path(tmp).parent_path().string();
   const double free_kb = statvfs(dir.c_str(), &v) == 0 ? double(v.f_bavail) * double(v.f_frsize) / 1024 : -1;
-  throw std::runtime_error(fmt::format("cannot write {}: {} ({:.0f} kB free on its file system{}); the shards "
+  throw StorageError(fmt::format("cannot write {}: {} ({:.0f} kB free on its file system after removing it{}); the shards "
                                        "written before are complete, run the same command again to resume",
-                                       tmp, e.what(), free_kb, free_kb < 1024 ? ": the disk is full" : ""));
+                                       tmp, e.what(), free_kb, free_kb < 1024 ? ": the disk is full" : ": the disk was full"));
 }
 
 void ShardWriter::add(const ShardShape& s) {

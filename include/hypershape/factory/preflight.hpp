@@ -33,6 +33,10 @@ inline constexpr double max_dataset_bytes = 1024.0 * 1024 * 1024 * 1024;
 void check_resources(const config::DatasetConfig& cfg, const DatasetEstimate& e, double bytes_to_write,
                      const std::string& output_dir, bool force);
 
+/// Before each shard (group roots): throws io::StorageError, before HDF5 opens anything, when
+/// the file system of `output_dir` has less than half of `shard_bytes` (the estimate) free.
+void check_shard_space(const std::string& output_dir, std::int64_t shard, double shard_bytes);
+
 /// Human units: "1.2 GB", "3h20m".
 std::string format_bytes(double bytes);
 std::string format_duration(double seconds);

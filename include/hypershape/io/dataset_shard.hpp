@@ -7,6 +7,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <variant>
 #include <vector>
@@ -51,9 +52,17 @@ struct ShardHeader {
   std::map<std::string, std::string> software;
 };
 
+/// A shard could not be written (a full disk, an I/O error). Its temporary file is gone, but
+/// HDF5 1.10.8 may still hold the file and crash at library shutdown (measured: exit 139 in
+/// H5F__close_cb after a failed flush), so a driver ends the process without HDF5's shutdown.
+class StorageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 /// Writes one shard: add() each shape in order, then commit(). Destroying an uncommitted
 /// writer removes the temporary file. A failed write (a full disk) removes it too and throws
-/// std::runtime_error naming the file and the free space; HDF5 prints nothing. Not collective.
+/// StorageError naming the file and the free space; HDF5 prints nothing. Not collective.
 class ShardWriter {
  public:
   /// Creates `path` + ".tmp" (truncating a stale one). Throws std::runtime_error.
