@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdio>
 #include <csignal>
 #include <filesystem>
 #include <regex>
@@ -213,10 +214,16 @@ OutputState open_output(const config::DatasetConfig& cfg, const GenerateOptions&
     throw core::InputError("", "-o", "output exists and is not a directory: " + out.string());
   OutputState st;
   st.text = dataset_text(cfg, out);
-  std::int64_t missing = 0;
-  for (std::int64_t k = opt.task_index; k < n_shards; k += opt.task_count)
-    missing += fs::exists(out / "shards" / shard_name(k), ec) ? 0 : shapes_in_shard(cfg, k);
-  check_resources(cfg, est, est.bytes_per_shape * double(missing), opt.output_dir, opt.force);
+  // Shapes still to write: this task's share, less the shards on disk (one listing: a huge
+  // count must be refused at once, not after a stat per shard).
+  double missing = double(cfg.n_shapes) / opt.task_count;
+  for (const auto& e : fs::directory_iterator(out / "shards", ec)) {
+    std::int64_t k = -1;
+    if (std::sscanf(e.path().filename().c_str(), "shard-%ld.h5", &k) == 1 && e.path().extension() == ".h5" &&
+        k >= 0 && k < n_shards && k % opt.task_count == opt.task_index)
+      missing -= double(shapes_in_shard(cfg, k));
+  }
+  check_resources(cfg, est, est.bytes_per_shape * std::max(0.0, missing), opt.output_dir, opt.force);
   fs::create_directories(out / "shards", ec);
   if (ec || access(out.c_str(), W_OK) != 0 || access((out / "shards").c_str(), W_OK) != 0)
     throw core::InputError("", "-o", "cannot create or write the output directory " + out.string() +

@@ -209,7 +209,7 @@ void ShardWriter::Impl::fail(const std::exception& e) {
   const double free_kb = statvfs(dir.c_str(), &v) == 0 ? double(v.f_bavail) * double(v.f_frsize) / 1024 : -1;
   throw StorageError(fmt::format("cannot write {}: {} ({:.0f} kB free on its file system after removing it{}); the shards "
                                        "written before are complete, run the same command again to resume",
-                                       tmp, e.what(), free_kb, free_kb < 1024 ? ": the disk is full" : ": the disk was full"));
+                                       tmp, e.what(), free_kb, free_kb < 1024 ? ": the disk is full" : ""));
 }
 
 void ShardWriter::add(const ShardShape& s) {
