@@ -118,6 +118,18 @@ struct ShardWriter::Impl {
   void abandon();
   /// abandon(), then throws StorageError naming the file, `e` and the free space.
   [[noreturn]] void fail(const std::exception& e);
+  /// Runs `fn` with HDF5's error printing off; a failure becomes fail().
+  template <class Fn>
+  void guarded(Fn&& fn) {
+    H5E_BEGIN_TRY {
+      try {
+        fn();
+      } catch (const std::exception& e) {
+        fail(e);
+      }
+    }
+    H5E_END_TRY;
+  }
 };
 
 namespace {
@@ -137,14 +149,7 @@ void write_text(hid_t f, const char* name, const std::string& text) {
 ShardWriter::ShardWriter(std::string path, const ShardHeader& h) : impl_(std::make_unique<Impl>()) {
   impl_->path = std::move(path);
   impl_->tmp = impl_->path + ".tmp";
-  H5E_BEGIN_TRY {
-    try {
-      write_header(h);
-    } catch (const std::exception& e) {
-      impl_->fail(e);
-    }
-  }
-  H5E_END_TRY;
+  impl_->guarded([&] { write_header(h); });
 }
 
 void ShardWriter::write_header(const ShardHeader& h) {
@@ -213,14 +218,7 @@ void ShardWriter::Impl::fail(const std::exception& e) {
 }
 
 void ShardWriter::add(const ShardShape& s) {
-  H5E_BEGIN_TRY {
-    try {
-      add_shape(s);
-    } catch (const std::exception& e) {
-      impl_->fail(e);
-    }
-  }
-  H5E_END_TRY;
+  impl_->guarded([&] { add_shape(s); });
 }
 
 void ShardWriter::add_shape(const ShardShape& s) {
@@ -240,14 +238,7 @@ void ShardWriter::add_shape(const ShardShape& s) {
 }
 
 void ShardWriter::commit(const std::function<void(std::uint32_t, std::uint64_t)>& before_rename) {
-  H5E_BEGIN_TRY {
-    try {
-      close_file();
-    } catch (const std::exception& e) {
-      impl_->fail(e);
-    }
-  }
-  H5E_END_TRY;
+  impl_->guarded([&] { close_file(); });
   fsync_path(impl_->tmp, false);
   if (before_rename) before_rename(file_crc32(impl_->tmp), std::uint64_t(fs::file_size(impl_->tmp)));
   fs::rename(impl_->tmp, impl_->path);
