@@ -239,10 +239,11 @@ OutputState open_output(const config::DatasetConfig& cfg, const GenerateOptions&
   return st;
 }
 
-}  // namespace
-
-RunReport generate(MPI_Comm comm, const config::DatasetConfig& cfg, const GenerateOptions& opt) {
-  const double start = core::now_seconds();
+/// Every check before anything is written (options, PETSc options by a trial solve; on rank 0
+/// the output, its identity and the free space), then rank 0's output state on every rank; the
+/// interrupt handlers from here on. Collective; throws InputError on every rank alike.
+OutputState prepare_run(MPI_Comm comm, const config::DatasetConfig& cfg, const GenerateOptions& opt,
+                        const DatasetEstimate& est, std::int64_t n_shards) {
   int rank = 0, size = 1;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
@@ -250,135 +251,51 @@ RunReport generate(MPI_Comm comm, const config::DatasetConfig& cfg, const Genera
     throw core::InputError("", "--task-index", fmt::format("must be in [0, {}) (--task-count)", opt.task_count));
   if (opt.group_size < 1 || opt.group_size > size)
     throw core::InputError("", "--group-size", fmt::format("must be in [1, {}] (the number of ranks)", size));
-
-  RunReport rep;
-  const std::int64_t S = cfg.shard_size;
-  rep.shards_total = (cfg.n_shapes + S - 1) / S;
-  // Everything is checked before anything is written: the base surface (read), the PETSc
-  // options (a trial solve), then on rank 0 the output, the identity and the free space.
-  const std::optional<geometry::Boundary> base = load_dataset_base(cfg);
   check_petsc_options(cfg, user_options(cfg, opt.petsc_command_line));
-  const DatasetEstimate est = estimate_dataset(cfg);
   core::info(comm, "[generate] estimate: about {} on disk and {} of CPU for the whole dataset (rough: ~{:.0f} nodes "
              "per shape)", format_bytes(est.bytes), format_duration(est.cpu_seconds), est.nodes_per_shape);
   OutputState out;
-  core::on_root(comm, [&] { out = open_output(cfg, opt, est, rep.shards_total); });
+  core::on_root(comm, [&] { out = open_output(cfg, opt, est, n_shards); });
   core::install_interrupt_handlers("generate", rank);
   broadcast_output(comm, out);
-  std::vector<std::int64_t>& todo = out.todo;
-  const std::int64_t done_before = out.done_before;
-  rep.shards_done_before = done_before;
-  HS_PETSC(PetscLogDefaultBegin());
+  return out;
+}
 
-  std::int64_t todo_shapes = 0;
-  for (auto k : todo) todo_shapes += std::min<std::int64_t>(S, cfg.n_shapes - k * S);
-  const std::int64_t todo_loads = todo_shapes * cfg.loads.count;
-  core::info(comm, "[generate] {}: {} shapes x {} load cases, {} shards ({} done before, {} to do by task {}/{}), "
-             "{} ranks in groups of {} -> {}",
-             cfg.name, cfg.n_shapes, cfg.loads.count, rep.shards_total, done_before, todo.size(),
-             opt.task_index, opt.task_count, size, opt.group_size, opt.output_dir);
+io::ShardHeader shard_header(const config::DatasetConfig& cfg, const OutputState& out,
+                             const std::map<std::string, std::string>& software, std::int64_t k) {
+  io::ShardHeader h;
+  h.dataset_name = cfg.name;
+  h.config_text = out.text;
+  h.scene_text = config::effects_yaml(cfg.scene);
+  h.config_hash = out.hash;
+  h.seed = cfg.seed;
+  h.dim = cfg.shapes.dim;
+  h.shard_index = k;
+  h.first_shape = k * cfg.shard_size;
+  h.n_shapes = shapes_in_shard(cfg, k);
+  h.n_loads = cfg.loads.count;
+  h.software = software;
+  return h;
+}
 
-  MPI_Comm group;
-  MPI_Comm_split(comm, rank / opt.group_size, rank, &group);
-  int grank = 0;
-  MPI_Comm_rank(group, &grank);
-  const bool group_root = grank == 0;
-  const std::string& hash = out.hash;
-  const auto software = software_versions();
+/// One shape's counters into this rank's report (summed over group roots by reduce_report).
+void add_to_report(const ShapeJobResult& r, RunReport& rep) {
+  rep.shapes += 1;
+  rep.shapes_failed += r.entry.ok ? 0 : 1;
+  rep.loads_ok += r.loads_ok;
+  rep.loads_failed += r.loads_failed;
+  rep.newton_iterations += r.newton_iterations;
+  rep.solves += r.solves;
+  rep.failed_increments += r.failed_increments;
+  rep.recovery_iterations += r.recovery_iterations;
+  rep.linear += r.linear;
+}
 
-  core::PhaseTimes times;
-  ShapeJobResult totals;  // counters only
-  std::int64_t shards_written = 0;
-  double last_print = core::now_seconds();
-  auto print_progress = [&](SharedCounters& c, bool force) {
-    if (rank != 0 || opt.progress_seconds <= 0) return;
-    const double now = core::now_seconds();
-    if (!force && now - last_print < opt.progress_seconds) return;
-    last_print = now;
-    const auto v = c.read();
-    const std::int64_t loads = v[loads_ok] + v[loads_failed];
-    const double rate = loads / std::max(1e-9, now - start);
-    core::info(comm, "[generate] {}/{} shapes, {}/{} load cases ({} failed, {} shapes failed), {:.2f} load cases/s, "
-               "elapsed {}, ETA {}", v[shapes_done], todo_shapes, loads, todo_loads, v[loads_failed],
-               v[shapes_failed], rate, format_duration(now - start),
-               format_duration(rate > 0 ? (todo_loads - loads) / rate : NAN));
-  };
-  {
-    SharedCounters counters(comm);
-    while (true) {
-      std::int64_t slot = 0;
-      if (group_root) slot = counters.fetch_add(next_shard, 1);
-      MPI_Bcast(&slot, 1, MPI_INT64_T, 0, group);
-      if (slot >= std::int64_t(todo.size())) break;
-      const std::int64_t k = todo[std::size_t(slot)];
-      const std::int64_t first = k * S, n = std::min(S, cfg.n_shapes - first);
-      std::unique_ptr<io::ShardWriter> writer;
-      if (group_root) {
-        check_shard_space(opt.output_dir, k, est.bytes_per_shape * double(n));
-        io::ShardHeader h;
-        h.dataset_name = cfg.name;
-        h.config_text = out.text;
-        h.scene_text = config::effects_yaml(cfg.scene);
-        h.config_hash = hash;
-        h.seed = cfg.seed;
-        h.dim = cfg.shapes.dim;
-        h.shard_index = k;
-        h.first_shape = first;
-        h.n_shapes = n;
-        h.n_loads = cfg.loads.count;
-        h.software = software;
-        writer = std::make_unique<io::ShardWriter>(
-            (fs::path(opt.output_dir) / "shards" / shard_name(k)).string(), h);
-      }
-      for (std::int64_t id = first; id < first + n; ++id) {
-        ShapeJobResult r = run_shape(group, cfg, base, id, [&](bool ok) {
-          if (group_root) counters.fetch_add(ok ? loads_ok : loads_failed, 1);
-          print_progress(counters, false);
-        });
-        if (group_root) {
-          if (!r.entry.ok) counters.fetch_add(loads_failed, r.loads_failed);
-          counters.fetch_add(shapes_done, 1);
-          if (!r.entry.ok) counters.fetch_add(shapes_failed, 1);
-          auto t = times.scope("io");
-          writer->add(r.entry);
-        }
-        for (const auto& [name, s] : r.times.all()) times.add(name, s);
-        rep.shapes += 1;
-        rep.shapes_failed += r.entry.ok ? 0 : 1;
-        rep.loads_ok += r.loads_ok;
-        rep.loads_failed += r.loads_failed;
-        rep.newton_iterations += r.newton_iterations;
-        rep.solves += r.solves;
-        rep.failed_increments += r.failed_increments;
-        rep.recovery_iterations += r.recovery_iterations;
-        rep.linear += r.linear;
-        if (!r.entry.ok)
-          core::log_line(MPI_COMM_SELF, core::Verbosity::normal,
-                         fmt::format("[generate] shape {} failed: {}", id, r.entry.failure.substr(0, 300)));
-      }
-      if (group_root) {
-        auto t = times.scope("io");
-        writer->commit([&](std::uint32_t crc, std::uint64_t bytes) {
-          write_shard_record(opt.output_dir, shard_identity(cfg, hash, k), crc, bytes);
-        });
-        ++shards_written;
-      }
-    }
-    // Rank 0 keeps the progress line going until every group is done.
-    if (rank == 0 && opt.progress_seconds > 0) {
-      while (true) {
-        const auto v = counters.read();
-        if (v[shapes_done] >= todo_shapes) break;
-        print_progress(counters, false);
-        std::this_thread::sleep_for(std::chrono::milliseconds(100));
-      }
-    }
-    MPI_Barrier(comm);
-    if (rank == 0 && todo_shapes > 0) print_progress(counters, true);
-  }
-  MPI_Comm_free(&group);
-
-  // ---- the run report ---------------------------------------------------------------------------
+/// The run report's numbers over `comm`: counters summed over the group roots (each holds its
+/// group's once), phase times likewise, factorisation time over all ranks, the wall time as
+/// the slowest rank's, and peak memory per rank gathered to rank 0 (`rss`). Collective.
+void reduce_report(MPI_Comm comm, bool group_root, const core::PhaseTimes& times, std::int64_t shards_written,
+                   double start, RunReport& rep, std::vector<double>& rss) {
   double pc_setup = 0;
   {
     PetscLogEvent ev;
@@ -411,54 +328,169 @@ RunReport generate(MPI_Comm comm, const config::DatasetConfig& cfg, const Genera
     rep.phase_seconds[p] = total;
   }
   MPI_Allreduce(&pc_setup, &rep.factorization_seconds, 1, MPI_DOUBLE, MPI_SUM, comm);
-  std::vector<double> rss(static_cast<std::size_t>(size));
+  int size = 1;
+  MPI_Comm_size(comm, &size);
+  rss.resize(static_cast<std::size_t>(size));
   double mine = peak_rss_mib();
   MPI_Gather(&mine, 1, MPI_DOUBLE, rss.data(), 1, MPI_DOUBLE, 0, comm);
   rep.seconds = core::now_seconds() - start;
   double max_seconds = 0;
   MPI_Allreduce(&rep.seconds, &max_seconds, 1, MPI_DOUBLE, MPI_MAX, comm);
   rep.seconds = max_seconds;
+}
 
-  // Index the dataset when every shard exists (the last task of an array does it).
-  int complete = 0;
-  core::on_root(comm, [&] {
-    if (rank == 0) {
-      nlohmann::json j;
-      j["dataset"] = cfg.name;
-      j["config"] = cfg.source;
-      j["task_index"] = opt.task_index;
-      j["task_count"] = opt.task_count;
-      j["ranks"] = size;
-      j["group_size"] = opt.group_size;
-      j["shards"] = {{"total", rep.shards_total}, {"done_before", rep.shards_done_before},
-                     {"written", rep.shards_written}};
-      j["shapes"] = {{"solved", rep.shapes}, {"failed", rep.shapes_failed}};
-      j["load_cases"] = {{"converged", rep.loads_ok}, {"failed", rep.loads_failed},
-                         {"per_second", (rep.loads_ok + rep.loads_failed) / std::max(1e-9, rep.seconds)}};
-      j["solver"] = {{"newton_iterations", rep.newton_iterations}, {"nonlinear_solves", rep.solves},
-                     {"failed_increments", rep.failed_increments},
-                     {"recovery_iterations", rep.recovery_iterations},
-                     {"numeric_factorizations", rep.linear.numeric_factorizations},
-                     {"symbolic_factorizations", rep.linear.symbolic_factorizations},
-                     {"krylov_iterations", rep.linear.krylov_iterations},
-                     {"tangent_assemblies", rep.linear.tangent_assemblies}};
-      j["seconds"] = {{"wall", rep.seconds}, {"phases_summed_over_groups", rep.phase_seconds},
-                      {"factorization_PCSetUp_summed_over_ranks", rep.factorization_seconds}};
-      j["peak_rss_mib_per_rank"] = rss;
-      j["software"] = software;
-      rep.json = j.dump(2);
-      write_atomically(fs::path(opt.output_dir) / "reports" /
-                           fmt::format("task-{:03d}-of-{:03d}.json", opt.task_index, opt.task_count),
-                       rep.json + "\n");
-      bool all = true;
-      for (std::int64_t k = 0; k < rep.shards_total && all; ++k)
-        all = fs::exists(fs::path(opt.output_dir) / "shards" / shard_name(k));
-      if (all) {
-        index_dataset(opt.output_dir);
-        complete = 1;
+/// Rank 0: the task's report (reports/task-I-of-N.json), then the index step when every shard
+/// exists (the last task of an array does it). Returns whether the dataset was indexed.
+bool report_and_index(const config::DatasetConfig& cfg, const GenerateOptions& opt, int size, RunReport& rep,
+                      const std::vector<double>& rss, const std::map<std::string, std::string>& software) {
+  bool complete = false;
+  nlohmann::json j;
+  j["dataset"] = cfg.name;
+  j["config"] = cfg.source;
+  j["task_index"] = opt.task_index;
+  j["task_count"] = opt.task_count;
+  j["ranks"] = size;
+  j["group_size"] = opt.group_size;
+  j["shards"] = {{"total", rep.shards_total}, {"done_before", rep.shards_done_before},
+                 {"written", rep.shards_written}};
+  j["shapes"] = {{"solved", rep.shapes}, {"failed", rep.shapes_failed}};
+  j["load_cases"] = {{"converged", rep.loads_ok}, {"failed", rep.loads_failed},
+                     {"per_second", (rep.loads_ok + rep.loads_failed) / std::max(1e-9, rep.seconds)}};
+  j["solver"] = {{"newton_iterations", rep.newton_iterations}, {"nonlinear_solves", rep.solves},
+                 {"failed_increments", rep.failed_increments},
+                 {"recovery_iterations", rep.recovery_iterations},
+                 {"numeric_factorizations", rep.linear.numeric_factorizations},
+                 {"symbolic_factorizations", rep.linear.symbolic_factorizations},
+                 {"krylov_iterations", rep.linear.krylov_iterations},
+                 {"tangent_assemblies", rep.linear.tangent_assemblies}};
+  j["seconds"] = {{"wall", rep.seconds}, {"phases_summed_over_groups", rep.phase_seconds},
+                  {"factorization_PCSetUp_summed_over_ranks", rep.factorization_seconds}};
+  j["peak_rss_mib_per_rank"] = rss;
+  j["software"] = software;
+  rep.json = j.dump(2);
+  write_atomically(fs::path(opt.output_dir) / "reports" /
+                       fmt::format("task-{:03d}-of-{:03d}.json", opt.task_index, opt.task_count),
+                   rep.json + "\n");
+  bool all = true;
+  for (std::int64_t k = 0; k < rep.shards_total && all; ++k)
+    all = fs::exists(fs::path(opt.output_dir) / "shards" / shard_name(k));
+  if (all) {
+    index_dataset(opt.output_dir);
+    complete = true;
+  }
+  return complete;
+}
+
+}  // namespace
+
+RunReport generate(MPI_Comm comm, const config::DatasetConfig& cfg, const GenerateOptions& opt) {
+  const double start = core::now_seconds();
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  RunReport rep;
+  const std::int64_t S = cfg.shard_size;
+  rep.shards_total = (cfg.n_shapes + S - 1) / S;
+  // The base surface is read (and so checked) before anything is written.
+  const std::optional<geometry::Boundary> base = load_dataset_base(cfg);
+  const DatasetEstimate est = estimate_dataset(cfg);
+  OutputState out = prepare_run(comm, cfg, opt, est, rep.shards_total);
+  std::vector<std::int64_t>& todo = out.todo;
+  const std::int64_t done_before = out.done_before;
+  rep.shards_done_before = done_before;
+  HS_PETSC(PetscLogDefaultBegin());
+
+  std::int64_t todo_shapes = 0;
+  for (auto k : todo) todo_shapes += std::min<std::int64_t>(S, cfg.n_shapes - k * S);
+  const std::int64_t todo_loads = todo_shapes * cfg.loads.count;
+  core::info(comm, "[generate] {}: {} shapes x {} load cases, {} shards ({} done before, {} to do by task {}/{}), "
+             "{} ranks in groups of {} -> {}",
+             cfg.name, cfg.n_shapes, cfg.loads.count, rep.shards_total, done_before, todo.size(),
+             opt.task_index, opt.task_count, size, opt.group_size, opt.output_dir);
+
+  MPI_Comm group;
+  MPI_Comm_split(comm, rank / opt.group_size, rank, &group);
+  int grank = 0;
+  MPI_Comm_rank(group, &grank);
+  const bool group_root = grank == 0;
+  const std::string& hash = out.hash;
+  const auto software = software_versions();
+
+  core::PhaseTimes times;
+  std::int64_t shards_written = 0;
+  double last_print = core::now_seconds();
+  auto print_progress = [&](SharedCounters& c, bool force) {
+    if (rank != 0 || opt.progress_seconds <= 0) return;
+    const double now = core::now_seconds();
+    if (!force && now - last_print < opt.progress_seconds) return;
+    last_print = now;
+    const auto v = c.read();
+    const std::int64_t loads = v[loads_ok] + v[loads_failed];
+    const double rate = loads / std::max(1e-9, now - start);
+    core::info(comm, "[generate] {}/{} shapes, {}/{} load cases ({} failed, {} shapes failed), {:.2f} load cases/s, "
+               "elapsed {}, ETA {}", v[shapes_done], todo_shapes, loads, todo_loads, v[loads_failed],
+               v[shapes_failed], rate, format_duration(now - start),
+               format_duration(rate > 0 ? (todo_loads - loads) / rate : NAN));
+  };
+  {
+    SharedCounters counters(comm);
+    while (true) {
+      std::int64_t slot = 0;
+      if (group_root) slot = counters.fetch_add(next_shard, 1);
+      MPI_Bcast(&slot, 1, MPI_INT64_T, 0, group);
+      if (slot >= std::int64_t(todo.size())) break;
+      const std::int64_t k = todo[std::size_t(slot)];
+      const std::int64_t first = k * S, n = std::min(S, cfg.n_shapes - first);
+      std::unique_ptr<io::ShardWriter> writer;
+      if (group_root) {
+        check_shard_space(opt.output_dir, k, est.bytes_per_shape * double(n));
+        writer = std::make_unique<io::ShardWriter>((fs::path(opt.output_dir) / "shards" / shard_name(k)).string(),
+                                                   shard_header(cfg, out, software, k));
+      }
+      for (std::int64_t id = first; id < first + n; ++id) {
+        ShapeJobResult r = run_shape(group, cfg, base, id, [&](bool ok) {
+          if (group_root) counters.fetch_add(ok ? loads_ok : loads_failed, 1);
+          print_progress(counters, false);
+        });
+        if (group_root) {
+          if (!r.entry.ok) counters.fetch_add(loads_failed, r.loads_failed);
+          counters.fetch_add(shapes_done, 1);
+          if (!r.entry.ok) counters.fetch_add(shapes_failed, 1);
+          auto t = times.scope("io");
+          writer->add(r.entry);
+        }
+        for (const auto& [name, s] : r.times.all()) times.add(name, s);
+        add_to_report(r, rep);
+        if (!r.entry.ok)
+          core::log_line(MPI_COMM_SELF, core::Verbosity::normal,
+                         fmt::format("[generate] shape {} failed: {}", id, r.entry.failure.substr(0, 300)));
+      }
+      if (group_root) {
+        auto t = times.scope("io");
+        writer->commit([&](std::uint32_t crc, std::uint64_t bytes) {
+          write_shard_record(opt.output_dir, shard_identity(cfg, hash, k), crc, bytes);
+        });
+        ++shards_written;
       }
     }
-  });
+    // Rank 0 keeps the progress line going until every group is done.
+    if (rank == 0 && opt.progress_seconds > 0) {
+      while (true) {
+        const auto v = counters.read();
+        if (v[shapes_done] >= todo_shapes) break;
+        print_progress(counters, false);
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      }
+    }
+    MPI_Barrier(comm);
+    if (rank == 0 && todo_shapes > 0) print_progress(counters, true);
+  }
+  MPI_Comm_free(&group);
+
+  std::vector<double> rss;
+  reduce_report(comm, group_root, times, shards_written, start, rep, rss);
+  int complete = 0;
+  core::on_root(comm, [&] { complete = report_and_index(cfg, opt, size, rep, rss, software) ? 1 : 0; });
   MPI_Bcast(&complete, 1, MPI_INT, 0, comm);
   rep.indexed = complete == 1;
   core::remove_interrupt_handlers();
