@@ -50,7 +50,7 @@ void check_output_path(const std::string& out) {
 }
 
 /// The PETSc option names among the arguments CLI11 left (`-name [value]`); anything else is
-/// an input error (a misspelt `--option`, a stray word), named before any work.
+/// an input error (a misspelt `--option`, a stray word), named before any work. Any subcommand.
 std::vector<std::string> petsc_option_names(const std::vector<std::string>& extras) {
   std::vector<std::string> names;
   bool value_allowed = false;
@@ -58,14 +58,14 @@ std::vector<std::string> petsc_option_names(const std::vector<std::string>& extr
     const bool number = !a.empty() && (std::isdigit(static_cast<unsigned char>(a[0])) || a[0] == '.' ||
                                        (a.size() > 1 && a[0] == '-' && (std::isdigit(static_cast<unsigned char>(a[1])) || a[1] == '.')));
     if (a.rfind("--", 0) == 0)
-      throw core::InputError("", a, "unknown option of `hypershape generate` (see --help; PETSc options take one dash)");
+      throw core::InputError("", a, "unknown option (see `hypershape SUBCOMMAND --help`; PETSc options take one dash)");
     if (a.size() > 1 && a[0] == '-' && !number) {
       names.push_back(a);
       value_allowed = true;
     } else if (value_allowed) {
       value_allowed = false;  // the value of the PETSc option before it
     } else {
-      throw core::InputError("", a, "unexpected argument of `hypershape generate` (one config file; see --help)");
+      throw core::InputError("", a, "unexpected argument (see `hypershape SUBCOMMAND --help`)");
     }
   }
   return names;
@@ -189,8 +189,10 @@ int run(int argc, char** argv) {
     for (auto& [name, help] : physics::registered_effects()) core::info(comm, "{:20s} {}", name, help);
     return 0;
   }
+  // What CLI11 left are PETSc options; a misspelt --option or a stray word stops every subcommand.
+  const std::vector<std::string> petsc_names = petsc_option_names(app.remaining(true));
   if (*generate) {
-    gen.petsc_command_line = petsc_option_names(app.remaining(true));
+    gen.petsc_command_line = petsc_names;  // checked by a trial solve before any work
     return run_generate(comm, gen_config, gen_out, gen);
   }
   if (*index) {

@@ -126,6 +126,12 @@ else fail "petsc: the corrected config is refused after a bad option"; fi
 # ---- command line -----------------------------------------------------------------------------
 bad cli misspelt_long     2 "--task-indx: unknown option" "$(good)" --task-indx 1
 bad cli stray_word        2 "other.yaml: unexpected argument" "$(good)" other.yaml
+# the other subcommands too (they wrote nothing before; now they stop with the argument named)
+for sc in "solve -o $work/s.h5 --repaet 3" "shapes $work/fixed.yaml -o $work/s.h5 --frist 2" "index $work --forse"; do
+  msg=$("$bin" $sc 2>&1); code=$?; n_cases=$((n_cases + 1))
+  if [ "$code" -eq 2 ] && grep -q "unknown option" <<<"$msg" && [ ! -e "$work/s.h5" ]; then ok "cli/${sc%% *}_misspelt: $msg"
+  else fail "cli/${sc%% *}_misspelt: exit $code: $msg"; fi
+done
 bad cli task_range        2 "--task-index: must be in [0, 2)" "$(good)" --task-index 5 --task-count 2
 bad cli task_count_zero   2 "--task-index: must be in [0, 0)" "$(good)" --task-count 0
 bad cli group_zero        2 "--group-size: must be in [1, 1]" "$(good)" --group-size 0

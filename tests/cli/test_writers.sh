@@ -44,7 +44,7 @@ if same_bytes "$work/ref" "$work/ref2" && [ "$(grep -o '"crc32": "[0-9a-f]*"' "$
 else fail "two identical runs differ in bytes"; fi
 
 # ---- the lock -----------------------------------------------------------------------------------
-sed -e 's/count: 8, h: 0.15/count: 16, h: 0.12/' "$work/ds.yaml" > "$work/long.yaml"
+sed -e 's/count: 8, h: 0.15/count: 10, h: 0.12/' "$work/ds.yaml" > "$work/long.yaml"
 wait_for() { for _ in $(seq 1 400); do compgen -G "$1" >/dev/null && return 0; sleep 0.05; done; return 1; }
 bg "$work/long.yaml" "$work/busy"; pid=$!
 wait_for "$work/busy/.locks/task-0-of-1.lock" || fail "no lock file appeared"
