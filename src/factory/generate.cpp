@@ -122,11 +122,13 @@ void broadcast_output(MPI_Comm comm, OutputState& st) {
 /// The first line where two canonical texts differ, for the "another dataset" message.
 std::string first_difference(const std::string& a, const std::string& b) {
   std::istringstream sa(a), sb(b);
-  std::string la, lb;
+  std::string la, lb, section;  // section: the last unindented line ("shapes:"), for nested keys
   while (true) {
     const bool ga = bool(std::getline(sa, la)), gb = bool(std::getline(sb, lb));
     if (!ga && !gb) return "";
-    if (la != lb || ga != gb) return fmt::format("'{}' there, '{}' here", ga ? la : "", gb ? lb : "");
+    const auto at = [&](const std::string& l) { return l.rfind("  ", 0) == 0 ? section + " " + l.substr(2) : l; };
+    if (la != lb || ga != gb) return fmt::format("'{}' there, '{}' here", ga ? at(la) : "", gb ? at(lb) : "");
+    if (!la.empty() && la[0] != ' ') section = la;
   }
 }
 
@@ -139,21 +141,22 @@ bool any_shard(const fs::path& out) {
 
 /// The text stored with the data: the existing dataset.yaml when it holds this dataset (the
 /// same meaning, whatever its layout), else this config's (nothing there yet, or what a start
-/// on a full disk left: an empty or unparsable dataset.yaml and no shard). Throws InputError
-/// for another dataset. Reads only.
+/// on a full disk left: an empty dataset.yaml and no shard). Throws InputError for another
+/// dataset or a dataset.yaml that is not a config. Reads only.
 std::string dataset_text(const config::DatasetConfig& cfg, const fs::path& out) {
   const fs::path yaml = out / "dataset.yaml";
   std::error_code ec;
   if (!fs::exists(yaml, ec)) return cfg.text;
   const std::string there = read_text(yaml);
+  // An empty dataset.yaml and no shard: what a start on a full disk left (before writes were
+  // checked): nothing to protect.
+  if (there.find_first_not_of(" \t\r\n") == std::string::npos && !any_shard(out)) return cfg.text;
   std::string meaning;
   try {
     meaning = config::canonical_text(config::parse_dataset_text(there, yaml.string(), out.string()));
   } catch (const std::exception& e) {
-    if (!any_shard(out)) return cfg.text;  // a start that failed before any shard
-    throw core::InputError("", "-o", fmt::format("{} is not a dataset config ({}), and {} holds shards: repair "
-                                                 "or remove it, or use another output directory",
-                                                 yaml.string(), e.what(), (out / "shards").string()));
+    throw core::InputError("", "-o", fmt::format("{} is not a dataset config ({}): repair or remove it, or use "
+                                                 "another output directory", yaml.string(), e.what()));
   }
   const std::string mine = config::canonical_text(cfg);
   if (meaning != mine)

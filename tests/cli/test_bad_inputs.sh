@@ -140,9 +140,20 @@ bad cli progress_word     2 "--progress"                  "$(good)" --progress a
 # ---- identity (an existing directory) ---------------------------------------------------------
 "$bin" -q generate "$work/fixed.yaml" --progress 0 -o "$work/have" >/dev/null 2>&1 || fail "a dataset to protect"
 OUT="$work/have" bad identity other_seed 2 "holds another dataset (its dataset.yaml means something else: 'seed: 7' there, 'seed: 8' here)" "$(sub 's/^seed: 7/seed: 8/')"
-OUT="$work/have" bad identity other_count 2 "holds another dataset" "$(sub 's/count: 2, h/count: 3, h/')"
+OUT="$work/have" bad identity other_count 2 "holds another dataset (its dataset.yaml means something else: 'shapes: count: 2' there, 'shapes: count: 3' here)" "$(sub 's/count: 2, h/count: 3, h/')"
 mkdir -p "$work/garbled/shards" && echo "{not: yaml: at all" > "$work/garbled/dataset.yaml" && cp "$work/have/shards/shard-000000.h5" "$work/garbled/shards/"
 OUT="$work/garbled" bad identity garbled_yaml 2 "dataset.yaml is not a dataset config" "$(good)"
+mkdir -p "$work/foreign" && printf 'title: my notes
+' > "$work/foreign/dataset.yaml"   # someone else's file, no shards
+OUT="$work/foreign" bad identity foreign_yaml 2 "dataset.yaml is not a dataset config" "$(good)"
+# what a start on a full disk left before writes were checked: an empty dataset.yaml, a 0-byte
+# temporary shard; the directory is taken, not refused as "another dataset"
+mkdir -p "$work/empty_start/shards" && : > "$work/empty_start/dataset.yaml" && : > "$work/empty_start/shards/shard-000000.h5.tmp"
+n_cases=$((n_cases + 1))
+if "$bin" -q generate "$work/fixed.yaml" --progress 0 -o "$work/empty_start" >/dev/null 2>&1 &&
+   [ -s "$work/empty_start/dataset.yaml" ] && [ ! -e "$work/empty_start/shards/shard-000000.h5.tmp" ]; then
+  ok "identity/empty_start: an empty dataset.yaml and a 0-byte temporary shard do not block the directory"
+else fail "identity/empty_start: refused or left the temporary shard"; fi
 
 # ---- surface files ----------------------------------------------------------------------------
 surf() { sub "s|^preset: random2d|preset: random3d|; s|shapes: {count: 2, h: 0.2}|shapes: {count: 1, base: file, base_file: $1}|"; }
