@@ -12,6 +12,7 @@
 /// PETSc options (-snes_monitor, -pc_type ..., -log_view) pass through to PETSc.
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cctype>
 #include <cstdio>
 #include <cstdlib>
@@ -69,6 +70,25 @@ std::vector<std::string> petsc_option_names(const std::vector<std::string>& extr
     }
   }
   return names;
+}
+
+/// CLI11 reads `-options_left` as `-o ptions_left` (a short option with its value attached):
+/// single-dash words that start with a letter of a short option of ours (-o, -q, -n) and go on
+/// are PETSc options; they and their value (the next word, unless it is an option) are taken out
+/// of the arguments CLI11 sees and returned. `args` is argv without argv[0].
+std::vector<std::string> take_petsc_lookalikes(std::vector<std::string>& args) {
+  std::vector<std::string> kept, taken;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const auto& a = args[i];
+    if (a.size() > 2 && a[0] == '-' && (a[1] == 'o' || a[1] == 'q' || a[1] == 'n')) {
+      taken.push_back(a);
+      if (i + 1 < args.size() && args[i + 1][0] != '-') taken.push_back(args[++i]);
+    } else {
+      kept.push_back(a);
+    }
+  }
+  args = kept;
+  return taken;
 }
 
 int run_generate(MPI_Comm comm, const std::string& config_path, const std::string& out,
@@ -177,8 +197,11 @@ int run(int argc, char** argv) {
   auto* effects = app.add_subcommand("effects", "list the effects a scene may use");
   effects->allow_extras();
 
+  std::vector<std::string> args(argv + 1, argv + argc);
+  const std::vector<std::string> lookalikes = take_petsc_lookalikes(args);
+  std::reverse(args.begin(), args.end());  // CLI11 takes a vector last argument first
   try {
-    app.parse(argc, argv);
+    app.parse(args);
   } catch (const CLI::ParseError& e) {
     if (rank == 0) app.exit(e);
     return e.get_exit_code() == 0 ? 0 : 2;
@@ -190,7 +213,9 @@ int run(int argc, char** argv) {
     return 0;
   }
   // What CLI11 left are PETSc options; a misspelt --option or a stray word stops every subcommand.
-  const std::vector<std::string> petsc_names = petsc_option_names(app.remaining(true));
+  std::vector<std::string> extras = app.remaining(true);
+  extras.insert(extras.end(), lookalikes.begin(), lookalikes.end());
+  const std::vector<std::string> petsc_names = petsc_option_names(extras);
   if (*generate) {
     gen.petsc_command_line = petsc_names;  // checked by a trial solve before any work
     return run_generate(comm, gen_config, gen_out, gen);

@@ -34,6 +34,15 @@ void trial_solve(const config::DatasetConfig& cfg) {
   (void)nl.solve_for_target(lc.target);
 }
 
+/// Options PETSc reads only in PetscFinalize (or at start-up, for the whole process): no
+/// object of a trial solve asks for them.
+bool read_at_finalize(const std::string& name) {
+  for (const char* p : {"-options_left", "-options_view", "-malloc", "-memory_view", "-objects_dump", "-log_",
+                        "-info", "-on_error_"})
+    if (name.rfind(p, 0) == 0) return true;
+  return false;
+}
+
 std::string listed(const std::vector<UserOption>& options) {
   std::string s;
   for (const auto& o : options) s += (s.empty() ? "" : ", ") + o.name + " (" + o.origin + ")";
@@ -59,6 +68,7 @@ void check_petsc_options(const config::DatasetConfig& cfg, const std::vector<Use
   }
   PetscPopErrorHandler();
   for (const auto& o : options) {
+    if (read_at_finalize(o.name)) continue;
     PetscBool used = PETSC_FALSE;
     HS_PETSC(PetscOptionsUsed(nullptr, o.name.c_str() + 1, &used));  // stored without the dash
     if (!used)

@@ -116,7 +116,12 @@ bad petsc cfg_dash_name   2 "petsc.-pc_type: not a PETSc option name" "$(add 'pe
 bad petsc cfg_list_value  2 "petsc.pc_type: must be a scalar value" "$(add 'petsc: {pc_type: [lu]}')"
 bad petsc cli_misspelt    2 "command line: -ksp_typo: no PETSc object" "$(good)" -ksp_typo 3
 bad petsc cli_bad_type    2 "Unable to find requested PC type foo" "$(good)" -pc_type foo
+bad petsc cli_o_lookalike  2 "-obviously_wrong: no PETSc object" "$(good)" -obviously_wrong 3   # not `-o bviously_wrong`
 bad petsc cli_mumps_typo  2 "-mat_mumps_icntl_99: no PETSc object" "$(good)" -pc_type cholesky -pc_factor_mat_solver_type mumps -mat_mumps_icntl_99 1
+# options PETSc reads at finalize are not flagged; a good option passes
+if "$bin" -q generate "$work/fixed.yaml" --progress 0 -o "$work/out_finalize" -options_left 0 -pc_type lu >/dev/null 2>&1; then
+  ok "petsc: -options_left (read at finalize) and -pc_type lu accepted"; rm -rf "$work/out_finalize"
+else fail "petsc: -options_left or -pc_type lu refused"; fi
 # the issue: a bad option, then the corrected config on the same directory
 good > "$work/fixed.yaml"
 if "$bin" -q generate "$work/fixed.yaml" --progress 0 -o "$work/out_cfg_misspelt" >/dev/null 2>&1; then
