@@ -22,6 +22,7 @@ representations: {grid_size: 8}
 output: {shard_size: 1}
 YAML
 }
+good > "$work/fixed.yaml"
 tree() { [ -e "$1" ] && find "$1" -type f -print0 | sort -z | xargs -0 -r md5sum; }
 n_cases=0 classes=""
 
@@ -123,7 +124,6 @@ if "$bin" -q generate "$work/fixed.yaml" --progress 0 -o "$work/out_finalize" -o
   ok "petsc: -options_left (read at finalize) and -pc_type lu accepted"; rm -rf "$work/out_finalize"
 else fail "petsc: -options_left or -pc_type lu refused"; fi
 # the issue: a bad option, then the corrected config on the same directory
-good > "$work/fixed.yaml"
 if "$bin" -q generate "$work/fixed.yaml" --progress 0 -o "$work/out_cfg_misspelt" >/dev/null 2>&1; then
   ok "petsc: the corrected config runs in the directory the bad one was refused for"
 else fail "petsc: the corrected config is refused after a bad option"; fi
