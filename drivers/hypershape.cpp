@@ -13,6 +13,8 @@
 /// PETSc options (-snes_monitor, -pc_type ..., -log_view) pass through to PETSc.
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -24,10 +26,12 @@
 #include "hypershape/core/log.hpp"
 #include "hypershape/core/petsc_handle.hpp"
 #include "hypershape/core/collective.hpp"
+#include "hypershape/core/interrupt.hpp"
 #include "hypershape/factory/dataset_index.hpp"
 #include "hypershape/factory/generate.hpp"
 #include "hypershape/factory/shape_set.hpp"
 #include "hypershape/factory/solve_scene.hpp"
+#include "hypershape/io/dataset_shard.hpp"
 #include "hypershape/io/shape_file.hpp"
 #include "hypershape/mesh/gmsh_mesher.hpp"
 #include "hypershape/physics/registry.hpp"
@@ -54,6 +58,47 @@ config::DatasetConfig dataset_to_generate(const std::string& config_path, const 
       : config_path.empty() ? config::parse_dataset_text(config::default_dataset_text(), "<default dataset>")
                             : config::parse_dataset_file(config_path);
   return mini ? config::mini_dataset(cfg) : cfg;
+}
+
+/// The PETSc option names among the arguments CLI11 left (`-name [value]`); anything else is
+/// an input error (a misspelt `--option`, a stray word), named before any work. Any subcommand.
+std::vector<std::string> petsc_option_names(const std::vector<std::string>& extras) {
+  std::vector<std::string> names;
+  bool value_allowed = false;
+  for (const auto& a : extras) {
+    const bool number = !a.empty() && (std::isdigit(static_cast<unsigned char>(a[0])) || a[0] == '.' ||
+                                       (a.size() > 1 && a[0] == '-' && (std::isdigit(static_cast<unsigned char>(a[1])) || a[1] == '.')));
+    if (a.rfind("--", 0) == 0)
+      throw core::InputError("", a, "unknown option (see `hypershape SUBCOMMAND --help`; PETSc options take one dash)");
+    if (a.size() > 1 && a[0] == '-' && !number) {
+      names.push_back(a);
+      value_allowed = true;
+    } else if (value_allowed) {
+      value_allowed = false;  // the value of the PETSc option before it
+    } else {
+      throw core::InputError("", a, "unexpected argument (see `hypershape SUBCOMMAND --help`)");
+    }
+  }
+  return names;
+}
+
+/// CLI11 reads `-options_left` as `-o ptions_left` (a short option with its value attached):
+/// single-dash words that start with a letter of a short option of ours (-o, -q, -n) and go on
+/// are PETSc options; they and their value (the next word, unless it is an option) are taken out
+/// of the arguments CLI11 sees and returned. `args` is argv without argv[0].
+std::vector<std::string> take_petsc_lookalikes(std::vector<std::string>& args) {
+  std::vector<std::string> kept, taken;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const auto& a = args[i];
+    if (a.size() > 2 && a[0] == '-' && (a[1] == 'o' || a[1] == 'q' || a[1] == 'n')) {
+      taken.push_back(a);
+      if (i + 1 < args.size() && args[i + 1][0] != '-') taken.push_back(args[++i]);
+    } else {
+      kept.push_back(a);
+    }
+  }
+  args = kept;
+  return taken;
 }
 
 int run_generate(MPI_Comm comm, const config::DatasetConfig& cfg, const std::string& out,
@@ -108,6 +153,7 @@ int run(int argc, char** argv) {
   const int rank = core::rank(comm);
   CLI::App app{"hypershape: hyperelastic finite-element data factory"};
   app.allow_extras();  // PETSc options
+  app.fallthrough();   // -q after the subcommand too
   app.require_subcommand(1);
   bool quiet = false;
   app.add_flag("-q,--quiet", quiet, "print only errors");
@@ -157,6 +203,7 @@ int run(int argc, char** argv) {
   generate->add_option("--task-count", gen.task_count, "number of slices (default: $SLURM_ARRAY_TASK_COUNT or 1)");
   generate->add_option("--group-size", gen.group_size, "ranks per shape (default 1)");
   generate->add_option("--progress", gen.progress_seconds, "seconds between progress lines (0: none)");
+  generate->add_flag("--force", gen.force, "write a dataset above the size bound (1 TB) or the free disk space");
   generate->allow_extras();
   auto* index = app.add_subcommand("index", "write the manifest, splits, statistics and XDMF of a dataset directory");
   std::string index_dir;
@@ -165,8 +212,11 @@ int run(int argc, char** argv) {
   auto* effects = app.add_subcommand("effects", "list the effects a scene may use");
   effects->allow_extras();
 
+  std::vector<std::string> args(argv + 1, argv + argc);
+  const std::vector<std::string> lookalikes = take_petsc_lookalikes(args);
+  std::reverse(args.begin(), args.end());  // CLI11 takes a vector last argument first
   try {
-    app.parse(argc, argv);
+    app.parse(args);
   } catch (const CLI::ParseError& e) {
     if (rank == 0) app.exit(e);
     return e.get_exit_code() == 0 ? 0 : 2;
@@ -177,8 +227,18 @@ int run(int argc, char** argv) {
     for (auto& [name, help] : physics::registered_effects()) core::info(comm, "{:20s} {}", name, help);
     return 0;
   }
-  if (*generate) return run_generate(comm, dataset_to_generate(gen_config, gen_preset, gen_mini), gen_out, gen);
-  if (*index) return run_index(comm, index_dir);
+  // What CLI11 left are PETSc options; a misspelt --option or a stray word stops every subcommand.
+  std::vector<std::string> extras = app.remaining(true);
+  extras.insert(extras.end(), lookalikes.begin(), lookalikes.end());
+  const std::vector<std::string> petsc_names = petsc_option_names(extras);
+  if (*generate) {
+    gen.petsc_command_line = petsc_names;  // checked by a trial solve before any work
+    return run_generate(comm, dataset_to_generate(gen_config, gen_preset, gen_mini), gen_out, gen);
+  }
+  if (*index) {
+    core::install_interrupt_handlers("index", rank);  // a manifest being replaced is removed
+    return run_index(comm, index_dir);
+  }
   if (*shapes) return run_shapes(comm, shapes_config, shapes_out, first, count);
   // Validate everything that can be validated before any work or output.
   check_output_path(out);
@@ -204,6 +264,13 @@ int main(int argc, char** argv) {
     // Input errors are raised on every rank alike: report once.
     if (core::rank(PETSC_COMM_WORLD) == 0) std::fprintf(stderr, "error: %s\n", e.what());
     code = 2;
+  } catch (const io::StorageError& e) {
+    // The shard's temporary file is gone; HDF5 may still hold it and crash in its shutdown
+    // (PetscFinalize -> MPI_Finalize -> HDF5): end here, with the message, the status and no crash.
+    std::fprintf(stderr, "[rank %d] error: %s\n", core::rank(PETSC_COMM_WORLD), e.what());
+    std::fflush(nullptr);
+    if (core::size(PETSC_COMM_WORLD) > 1) MPI_Abort(PETSC_COMM_WORLD, 1);
+    std::_Exit(1);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "[rank %d] error: %s\n", core::rank(PETSC_COMM_WORLD), e.what());
     code = 1;

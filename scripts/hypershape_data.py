@@ -618,6 +618,20 @@ def _walk(group, prefix=""):
             yield path, v
 
 
+def _nonfinite_attributes(h):
+    """Paths of numeric attributes (file, groups, datasets) holding NaN or Inf."""
+    bad = []
+
+    def look(name, obj):
+        for k, v in obj.attrs.items():
+            a = np.asarray(v)
+            if a.dtype.kind in "fc" and not np.isfinite(a).all():
+                bad.append(f"/{name}@{k}" if name else f"/@{k}")
+    look("", h)
+    h.visititems(look)
+    return bad
+
+
 def summary(path, out=sys.stdout):
     """Prints counts, splits, statistics and the shape/dtype/units of every array of one shape."""
     ds = open_dataset(path)
@@ -655,8 +669,8 @@ def summary(path, out=sys.stdout):
 
 def check_dataset(path, out=sys.stdout):
     """Verifies a dataset: every shard listed in manifest.json exists with the listed size and
-    CRC-32 and opens as a complete shard of this dataset, and every numeric array in every
-    shard is finite. Returns the list of problems (empty if sound)."""
+    CRC-32 and opens as a complete shard of this dataset, and every numeric array and attribute
+    in every shard is finite. Returns the list of problems (empty if sound)."""
     problems = []
     say = lambda s: print(s, file=out)  # noqa: E731
     try:
@@ -687,6 +701,7 @@ def check_dataset(path, out=sys.stdout):
             with h5py.File(f, "r") as h:
                 if _text(h.attrs.get("config_hash", b"")) != m["config_hash"] or h.attrs.get("complete") != 1:
                     bad.append("not a complete shard of this dataset (config_hash / complete)")
+                bad.extend(f"{a}: NaN/Inf attribute" for a in _nonfinite_attributes(h))
                 for p, v in _walk(h):
                     if v.dtype.kind in "fc":
                         n_arrays += 1

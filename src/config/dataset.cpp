@@ -1,6 +1,7 @@
 #include "hypershape/config/dataset.hpp"
 
 #include <cmath>
+#include <limits>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -21,11 +22,9 @@ void parse_shapes(const YamlBlock& b, const std::string& base_dir, factory::Shap
   // count is read first (it is the first error to report) but a directory family may leave it
   // out: then it is the number of files.
   const bool has_count = b.has("count");
-  if (has_count) {
-    const long n = b.integer("count");
-    if (n < 1) b.fail("count", "must be >= 1");
-    count = n;
-  }
+  // The plan, splits and manifest hold every shape id in memory: 10^8 is far past any dataset
+  // that fits a disk (the size estimate refuses much less, see factory/preflight.hpp).
+  if (has_count) count = b.integer("count", 1, 100000000, "shapes");
   const long dim = b.integer("dim");
   if (dim != 2 && dim != 3) b.fail("dim", "must be 2 or 3");
   s.dim = int(dim);
@@ -132,6 +131,24 @@ void parse_shapes(const YamlBlock& b, const std::string& base_dir, factory::Shap
   b.allowed("count, dim, base, base_file, base_dir, steps, velocity_unit, nodes_per_sigma, h, dirichlet_radius, "
             "max_turn_deg, min_feature_fraction, max_attempts, quality");
   b.check_all_used();
+}
+
+/// The sections that are mappings, checked before the preset is merged in (a scalar there
+/// would otherwise replace the preset's mapping, or reach yaml-cpp's operator[]).
+void check_sections(const YAML::Node& root, const std::string& source) {
+  const YamlBlock top(root, source, "");
+  for (const char* s : {"shapes", "loads", "material", "effects", "mesh", "representations", "split", "output",
+                        "solver", "petsc"})
+    (void)top.mapping(s);
+}
+
+/// The dataset's name is a directory name (results/<name> without -o) and a file-name part.
+void check_name(const YamlBlock& top, const std::string& name) {
+  const bool word = !name.empty() && name.size() <= 100 && name.find_first_not_of(
+      "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_.-") == std::string::npos;
+  if (!word || name.front() == '.' || name.front() == '-')
+    top.fail("name", "must be 1-100 letters, digits, '_', '-' or '.', not starting with '.' or '-' (it names "
+                     "the output directory results/<name>), got '" + name + "'");
 }
 
 /// Merges `over` into `base`: mappings key by key (recursively), anything else replaced.
@@ -284,13 +301,9 @@ output: {shard_size: 2}
 
 DatasetConfig parse_dataset_text(const std::string& text, const std::string& source,
                                  const std::string& base_dir_in) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    throw InputError(source, "", std::string("not valid YAML: ") + e.what());
-  }
+  YAML::Node root = load_yaml(text, source);
   if (!root || !root.IsMap()) throw InputError(source, "", "a dataset config must be a YAML mapping");
+  check_sections(root, source);
   DatasetConfig c;
   c.source = source;
   std::string base_dir = base_dir_in;
@@ -315,11 +328,8 @@ DatasetConfig parse_dataset_text(const std::string& text, const std::string& sou
   }
   YamlBlock top(root, source, "");
   c.name = top.text("name");
-  if (c.name.empty() || c.name.find_first_of("/\\ \t") != std::string::npos)
-    top.fail("name", "must be a non-empty word without spaces or slashes");
-  const long seed = top.integer("seed");
-  if (seed < 0) top.fail("seed", "must be >= 0");
-  c.seed = std::uint64_t(seed);
+  check_name(top, c.name);
+  c.seed = std::uint64_t(top.integer("seed", 0, std::numeric_limits<long>::max()));
   if (!top.has("shapes")) top.fail("shapes", "missing (the shape family is required)");
   c.scene_given = bool(root["effects"]);
   if (c.scene_given && root["material"])

@@ -31,12 +31,7 @@ load: {target: 0.3}
 }
 
 Scene parse_scene_text(const std::string& text, const std::string& source, const std::string& base_dir) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    throw InputError(source, "", std::string("not valid YAML: ") + e.what());
-  }
+  YAML::Node root = load_yaml(text, source);
   if (!root || !root.IsMap()) throw InputError(source, "", "a scene must be a YAML mapping");
   Scene s;
   s.source = source;

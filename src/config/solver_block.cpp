@@ -40,6 +40,9 @@ void parse_petsc_block(const YamlBlock& petsc, std::vector<std::pair<std::string
   for (const auto& kv : petsc.node()) {
     const std::string k = kv.first.Scalar();
     petsc.get(k);
+    if (k.empty() || k.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") !=
+                         std::string::npos || k.front() == '_')
+      petsc.fail(k, "not a PETSc option name: letters, digits and '_', without the leading dash (snes_monitor)");
     if (!kv.second.IsNull() && !kv.second.IsScalar()) petsc.fail(k, "must be a scalar value");
     out.emplace_back("-" + k, kv.second.IsNull() ? "" : kv.second.Scalar());
   }

@@ -41,6 +41,14 @@ class YamlBlock {
     used_.insert(key);
     return node_ && node_.IsMap() && node_[key] && !node_[key].IsNull();
   }
+  /// The value of `key` if it must be a mapping (absent: a null node); names the key otherwise.
+  YAML::Node mapping(const std::string& key) const {
+    auto n = get(key);
+    if (n && !n.IsNull() && !n.IsMap())
+      fail(key, "must be a mapping of keys to values (key: value, or {key: value}), got " +
+                    std::string(n.IsScalar() ? "'" + n.Scalar() + "'" : "a list"));
+    return n;
+  }
   YAML::Node get(const std::string& key) const {
     used_.insert(key);
     return node_ && node_.IsMap() ? node_[key] : YAML::Node();
@@ -61,7 +69,17 @@ class YamlBlock {
   long integer(const std::string& key) const {
     const double v = number(key);
     if (v != std::floor(v)) fail(key, "must be an integer");
+    // Beyond 2^53 a double no longer holds every integer (and 1e30 overflows a long).
+    if (std::abs(v) > 9007199254740992.0) fail(key, "must be an integer of magnitude at most 2^53, got " + fmt_number(v));
     return long(v);
+  }
+  /// An integer in [lo, hi]; the message names the range (and `unit`, e.g. "shapes per shard").
+  long integer(const std::string& key, long lo, long hi, const std::string& unit = "") const {
+    const long v = integer(key);
+    if (v < lo || v > hi)
+      fail(key, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]" +
+                    (unit.empty() ? "" : " (" + unit + ")") + ", got " + std::to_string(v));
+    return v;
   }
   bool boolean(const std::string& key) const {
     auto n = get(key);
@@ -115,5 +133,8 @@ class YamlBlock {
   mutable std::set<std::string> used_;
 };
 
+/// Parses YAML text, rejecting what yaml-cpp lets through silently: a key given twice in a
+/// mapping and a quoted string not closed on its line. Throws InputError naming `source`.
+YAML::Node load_yaml(const std::string& text, const std::string& source);
 
 }  // namespace hypershape::config

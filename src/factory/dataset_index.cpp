@@ -14,6 +14,7 @@
 #include "hypershape/core/input_error.hpp"
 #include "hypershape/core/random.hpp"
 #include "hypershape/factory/generate.hpp"
+#include "hypershape/factory/shard_record.hpp"
 #include "hypershape/io/dataset_shard.hpp"
 #include "hypershape/io/dataset_xdmf.hpp"
 #include "text_file.hpp"
@@ -54,8 +55,8 @@ IndexReport index_dataset(const std::string& dir) {
   const fs::path yaml = root / "dataset.yaml";
   if (!fs::exists(yaml)) throw core::InputError(dir, "", "not a dataset directory (no dataset.yaml)");
   const config::DatasetConfig cfg = config::parse_dataset_file(yaml.string());
-  // The shards carry the digest of the text generate wrote to dataset.yaml.
-  const std::string hash = io::text_digest(detail::read_text(yaml));
+  // The shards carry the digest of the dataset's meaning (config::canonical_text).
+  const std::string hash = config_hash(cfg);
   IndexReport rep;
   rep.shards = (cfg.n_shapes + cfg.shard_size - 1) / cfg.shard_size;
 
@@ -70,10 +71,11 @@ IndexReport index_dataset(const std::string& dir) {
       rep.missing_shards.push_back(k);
       continue;
     }
+    if (const auto problem = shard_problem(dir, shard_identity(cfg, hash, k)); !problem.empty())
+      throw std::runtime_error(p.string() + ": " + problem + "; run `hypershape generate` on this directory "
+                               "with its config again: it redoes the shard");
     summaries.push_back(io::read_shard_summary(p.string()));
     const auto& s = summaries.back();
-    if (s.header.config_hash != hash || s.header.shard_index != k)
-      throw std::runtime_error(p.string() + ": belongs to another dataset or shard");
     std::int64_t ok = 0, failed = 0, lok = 0, lfailed = 0;
     for (const auto& sh : s.shapes) {
       (sh.ok ? ok : failed) += 1;

@@ -327,12 +327,17 @@ double boundary_measure(const Boundary& b) {
   return sum;
 }
 
+namespace {
+/// 1 for a disk (2D: 4 pi A / P^2) or a ball (3D: 36 pi V^2 / S^3), smaller for any other shape.
+double isoperimetric_of(int dim, double measure, double boundary) {
+  return dim == 2 ? 4 * std::numbers::pi * measure / (boundary * boundary)
+                  : 36 * std::numbers::pi * measure * measure / (boundary * boundary * boundary);
+}
+}  // namespace
+
 double isoperimetric_ratio(const Boundary& b) {
-  if (b.dim != 2)
-    throw std::invalid_argument("isoperimetric_ratio: only for 2D boundaries, got dimension " +
-                                std::to_string(b.dim));
-  const double p = boundary_measure(b);
-  return 4 * std::numbers::pi * enclosed_measure(b) / (p * p);
+  check_dim(b, "isoperimetric_ratio");
+  return isoperimetric_of(b.dim, enclosed_measure(b), boundary_measure(b));
 }
 
 double directed_hausdorff_distance(const Boundary& from, const Boundary& to, double tolerance) {
@@ -362,9 +367,7 @@ ShapeMetrics compute_metrics(const Boundary& shape, const Boundary* base,
   ShapeMetrics m;
   m.measure = enclosed_measure(shape);
   m.boundary_measure = boundary_measure(shape);
-  m.isoperimetric_ratio =
-      shape.dim == 2 ? 4 * std::numbers::pi * m.measure / (m.boundary_measure * m.boundary_measure)
-                     : std::numeric_limits<double>::quiet_NaN();
+  m.isoperimetric_ratio = isoperimetric_of(shape.dim, m.measure, m.boundary_measure);
   m.hausdorff_to_base = base ? hausdorff_distance(shape, *base, hausdorff_tolerance)
                              : std::numeric_limits<double>::quiet_NaN();
   m.n_boundary_facets = shape.n_facets();

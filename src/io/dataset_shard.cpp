@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <fmt/format.h>
 #include <hdf5.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 #include <zlib.h>
 
@@ -12,6 +13,7 @@
 #include <numeric>
 
 #include "h5_util.hpp"
+#include "hypershape/core/interrupt.hpp"
 #include "shape_group.hpp"
 
 namespace hypershape::io {
@@ -19,13 +21,6 @@ namespace hypershape::io {
 namespace {
 
 namespace fs = std::filesystem;
-
-/// Creation property list without object timestamps: the same data gives the same bytes.
-Id untimed(hid_t cls) {
-  Id p{check_id(H5Pcreate(cls), "plist"), H5Pclose};
-  check(H5Pset_obj_track_times(p.id, false), "track times");
-  return p;
-}
 
 Id make_group(hid_t parent, const std::string& name) {
   Id gcpl = untimed(H5P_GROUP_CREATE);
@@ -117,6 +112,24 @@ struct ShardWriter::Impl {
   std::string path, tmp;
   hid_t file = -1, shapes = -1;
   bool committed = false;
+  int slot = -1;  ///< core::register_temporary of tmp (a signal removes it)
+  ~Impl() { core::unregister_temporary(slot); }
+  /// Closes what is open and removes the temporary file, whatever state HDF5 is in.
+  void abandon();
+  /// abandon(), then throws StorageError naming the file, `e` and the free space.
+  [[noreturn]] void fail(const std::exception& e);
+  /// Runs `fn` with HDF5's error printing off; a failure becomes fail().
+  template <class Fn>
+  void guarded(Fn&& fn) {
+    H5E_BEGIN_TRY {
+      try {
+        fn();
+      } catch (const std::exception& e) {
+        fail(e);
+      }
+    }
+    H5E_END_TRY;
+  }
 };
 
 namespace {
@@ -136,7 +149,13 @@ void write_text(hid_t f, const char* name, const std::string& text) {
 ShardWriter::ShardWriter(std::string path, const ShardHeader& h) : impl_(std::make_unique<Impl>()) {
   impl_->path = std::move(path);
   impl_->tmp = impl_->path + ".tmp";
-  impl_->file = check_id(H5Fcreate(impl_->tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
+  impl_->guarded([&] { write_header(h); });
+}
+
+void ShardWriter::write_header(const ShardHeader& h) {
+  impl_->slot = core::register_temporary(impl_->tmp);
+  Id fcpl = untimed(H5P_FILE_CREATE);  // the root group's timestamps too
+  impl_->file = check_id(H5Fcreate(impl_->tmp.c_str(), H5F_ACC_TRUNC, fcpl.id, H5P_DEFAULT),
                          "create " + impl_->tmp);
   const hid_t f = impl_->file;
   attr_string(f, "format", "hypershape-dataset");
@@ -168,14 +187,41 @@ ShardWriter::ShardWriter(std::string path, const ShardHeader& h) : impl_(std::ma
 }
 
 ShardWriter::~ShardWriter() {
-  if (!impl_ || impl_->committed) return;
-  if (impl_->shapes >= 0) H5Gclose(impl_->shapes);
-  if (impl_->file >= 0) H5Fclose(impl_->file);
+  if (impl_ && !impl_->committed) impl_->abandon();
+}
+
+void ShardWriter::Impl::abandon() {
+  // A write that failed (a full disk) leaves HDF5 with data it still wants to flush: at close,
+  // and at library shutdown, where it crashed (exit 139). Emptying the file first frees the
+  // space, so the close succeeds; then the file goes.
+  if (file >= 0 && ::truncate(tmp.c_str(), 0) != 0) {
+    // nothing more to free
+  }
+  H5E_BEGIN_TRY {
+    if (shapes >= 0) H5Gclose(shapes);
+    if (file >= 0) H5Fclose(file);
+  }
+  H5E_END_TRY;
+  shapes = file = -1;
   std::error_code ec;
-  fs::remove(impl_->tmp, ec);
+  fs::remove(tmp, ec);
+}
+
+void ShardWriter::Impl::fail(const std::exception& e) {
+  abandon();
+  struct statvfs v {};
+  const std::string dir = fs::path(tmp).parent_path().string();
+  const double free_kb = statvfs(dir.c_str(), &v) == 0 ? double(v.f_bavail) * double(v.f_frsize) / 1024 : -1;
+  throw StorageError(fmt::format("cannot write {}: {} ({:.0f} kB free on its file system after removing it{}); the shards "
+                                       "written before are complete, run the same command again to resume",
+                                       tmp, e.what(), free_kb, free_kb < 1024 ? ": the disk is full" : ""));
 }
 
 void ShardWriter::add(const ShardShape& s) {
+  impl_->guarded([&] { add_shape(s); });
+}
+
+void ShardWriter::add_shape(const ShardShape& s) {
   Id g = make_group(impl_->shapes, fmt::format("{:06d}", s.shape.shape_id));
   attr_string(g.id, "status", s.ok ? "ok" : "failed");
   if (!s.ok) {
@@ -191,7 +237,16 @@ void ShardWriter::add(const ShardShape& s) {
   write_strings(g.id, "loads/reason", s.load_reasons);
 }
 
-void ShardWriter::commit() {
+void ShardWriter::commit(const std::function<void(std::uint32_t, std::uint64_t)>& before_rename) {
+  impl_->guarded([&] { close_file(); });
+  fsync_path(impl_->tmp, false);
+  if (before_rename) before_rename(file_crc32(impl_->tmp), std::uint64_t(fs::file_size(impl_->tmp)));
+  fs::rename(impl_->tmp, impl_->path);
+  fsync_path(fs::path(impl_->path).parent_path().string(), true);
+  impl_->committed = true;
+}
+
+void ShardWriter::close_file() {
   const hid_t f = impl_->file;
   {
     Id a{check_id(H5Aopen(f, "complete", H5P_DEFAULT), "complete"), H5Aclose};
@@ -201,31 +256,49 @@ void ShardWriter::commit() {
   H5Gclose(impl_->shapes);
   impl_->shapes = -1;
   check(H5Fflush(f, H5F_SCOPE_GLOBAL), "flush " + impl_->tmp);
-  impl_->file = -1;
   check(H5Fclose(f), "close " + impl_->tmp);
-  fsync_path(impl_->tmp, false);
-  fs::rename(impl_->tmp, impl_->path);
-  fsync_path(fs::path(impl_->path).parent_path().string(), true);
-  impl_->committed = true;
+  impl_->file = -1;
+}
+
+namespace {
+
+ShardHeader read_header(hid_t file, const std::string& path) {
+  ShardHeader h;
+  if (read_attr_string(file, "format") != "hypershape-dataset")
+    throw std::runtime_error(path + ": not a hypershape dataset shard");
+  if (int(read_attr_double(file, "format_version")) != dataset_format_version)
+    throw std::runtime_error(path + ": unsupported format_version");
+  if (read_attr_double(file, "complete") != 1) throw std::runtime_error(path + ": incomplete shard");
+  h.dataset_name = read_attr_string(file, "dataset_name");
+  h.config_hash = read_attr_string(file, "config_hash");
+  h.seed = std::uint64_t(read_attr_double(file, "seed"));
+  h.dim = int(read_attr_double(file, "dim"));
+  h.shard_index = std::int64_t(read_attr_double(file, "shard_index"));
+  h.first_shape = std::int64_t(read_attr_double(file, "first_shape"));
+  h.n_shapes = std::int64_t(read_attr_double(file, "n_shapes"));
+  h.n_loads = int(read_attr_double(file, "n_loads"));
+  return h;
+}
+
+}  // namespace
+
+ShardHeader read_shard_header(const std::string& path) {
+  ShardHeader h;
+  H5E_BEGIN_TRY {
+    const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+    if (f < 0) throw std::runtime_error(path + ": not an HDF5 file (or unreadable)");
+    Id file{f, H5Fclose};
+    h = read_header(file.id, path);
+  }
+  H5E_END_TRY;
+  return h;
 }
 
 ShardSummary read_shard_summary(const std::string& path) {
   Id file{check_id(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), "open " + path), H5Fclose};
   ShardSummary out;
+  out.header = read_header(file.id, path);
   auto& h = out.header;
-  if (read_attr_string(file.id, "format") != "hypershape-dataset")
-    throw std::runtime_error(path + ": not a hypershape dataset shard");
-  if (int(read_attr_double(file.id, "format_version")) != dataset_format_version)
-    throw std::runtime_error(path + ": unsupported format_version");
-  if (read_attr_double(file.id, "complete") != 1) throw std::runtime_error(path + ": incomplete shard");
-  h.dataset_name = read_attr_string(file.id, "dataset_name");
-  h.config_hash = read_attr_string(file.id, "config_hash");
-  h.seed = std::uint64_t(read_attr_double(file.id, "seed"));
-  h.dim = int(read_attr_double(file.id, "dim"));
-  h.shard_index = std::int64_t(read_attr_double(file.id, "shard_index"));
-  h.first_shape = std::int64_t(read_attr_double(file.id, "first_shape"));
-  h.n_shapes = std::int64_t(read_attr_double(file.id, "n_shapes"));
-  h.n_loads = int(read_attr_double(file.id, "n_loads"));
   h.config_text = read_string(file.id, "config");
   Id all{check_id(H5Gopen2(file.id, "shapes", H5P_DEFAULT), "shapes"), H5Gclose};
   H5G_info_t info;
@@ -256,25 +329,6 @@ ShardSummary read_shard_summary(const std::string& path) {
     out.shapes.push_back(std::move(s));
   }
   return out;
-}
-
-bool is_complete_shard(const std::string& path, const std::string& config_hash) {
-  if (!fs::exists(path)) return false;
-  bool ok = false;
-  H5E_BEGIN_TRY {
-    const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-    if (f >= 0) {
-      try {
-        ok = read_attr_double(f, "complete") == 1 && read_attr_string(f, "config_hash") == config_hash &&
-             read_attr_string(f, "format") == "hypershape-dataset";
-      } catch (...) {
-        ok = false;
-      }
-      H5Fclose(f);
-    }
-  }
-  H5E_END_TRY;
-  return ok;
 }
 
 std::uint32_t file_crc32(const std::string& path) {

@@ -27,10 +27,18 @@ struct Id {
   }
 };
 
+/// A creation property list (dataset, group or file) without object timestamps: the same data
+/// gives the same bytes, run after run.
+inline Id untimed(hid_t cls) {
+  Id p{check_id(H5Pcreate(cls), "plist"), H5Pclose};
+  check(H5Pset_obj_track_times(p.id, false), "track times");
+  return p;
+}
+
 inline void write_2d(hid_t parent, const char* name, hid_t type, const void* data, hsize_t rows, hsize_t cols) {
   hsize_t dims[2] = {rows, cols};
   Id space{check_id(H5Screate_simple(2, dims, nullptr), name), H5Sclose};
-  Id plist{check_id(H5Pcreate(H5P_DATASET_CREATE), name), H5Pclose};
+  Id plist = untimed(H5P_DATASET_CREATE);
   if (rows > 0) {
     hsize_t chunk[2] = {std::min<hsize_t>(rows, 16384), cols};
     check(H5Pset_chunk(plist.id, 2, chunk), name);
@@ -58,7 +66,8 @@ inline void write_string_dataset(hid_t parent, const char* name, const std::stri
   Id type{check_id(H5Tcopy(H5T_C_S1), name), H5Tclose};
   check(H5Tset_size(type.id, std::max<std::size_t>(1, v.size())), name);
   Id space{check_id(H5Screate(H5S_SCALAR), name), H5Sclose};
-  Id ds{check_id(H5Dcreate2(parent, name, type.id, space.id, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), name), H5Dclose};
+  Id dcpl = untimed(H5P_DATASET_CREATE);
+  Id ds{check_id(H5Dcreate2(parent, name, type.id, space.id, H5P_DEFAULT, dcpl.id, H5P_DEFAULT), name), H5Dclose};
   check(H5Dwrite(ds.id, type.id, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.empty() ? " " : v.c_str()), name);
 }
 
@@ -66,7 +75,8 @@ inline void write_string_dataset(hid_t parent, const char* name, const std::stri
 inline void write_1d(hid_t parent, const char* name, hid_t type, const void* data, hsize_t n) {
   hsize_t dims[1] = {n};
   Id space{check_id(H5Screate_simple(1, dims, nullptr), name), H5Sclose};
-  Id ds{check_id(H5Dcreate2(parent, name, type, space.id, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), name), H5Dclose};
+  Id dcpl = untimed(H5P_DATASET_CREATE);
+  Id ds{check_id(H5Dcreate2(parent, name, type, space.id, H5P_DEFAULT, dcpl.id, H5P_DEFAULT), name), H5Dclose};
   if (n > 0) check(H5Dwrite(ds.id, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), name);
 }
 
@@ -92,7 +102,8 @@ void for_each_group(hid_t parent, const char* path, Fn&& fn) {
 }
 
 inline Id group(hid_t parent, const std::string& name) {
-  return {check_id(H5Gcreate2(parent, name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), name), H5Gclose};
+  Id gcpl = untimed(H5P_GROUP_CREATE);
+  return {check_id(H5Gcreate2(parent, name.c_str(), H5P_DEFAULT, gcpl.id, H5P_DEFAULT), name), H5Gclose};
 }
 
 template <class T>

@@ -7,7 +7,8 @@
   - rel_l2 / rel_h1 (the paper's discrete norms) against hand computations, exact gradients of
     linear (P1) and quadratic (P2) fields, grid_to_mesh exact for linear functions;
   - the torch Datasets through DataLoaders (0 and 2 workers), normalisation from stats.json;
-  - `check` passes on a good dataset and fails after one byte of a shard is changed.
+  - `check` passes on a good dataset (2D and 3D: no NaN attribute either) and fails after one
+    byte of a shard is changed, with a NaN in an array, or a NaN in an attribute.
 Needs HYPERSHAPE_BIN and HYPERSHAPE_SOURCE_DIR (set by CTest)."""
 import json
 import math
@@ -352,6 +353,11 @@ def cli(path, work):
         g["loads/grid_displacement"][0, 1, 1, 0] = np.nan
     r = subprocess.run([sys.executable, script, "check", bad], capture_output=True, text=True)
     check(r.returncode != 0 and "grid_displacement: 1 NaN/Inf" in r.stdout, "check names an array holding a NaN")
+    with h5py.File(first, "r+") as f:  # 3D shards once carried isoperimetric_ratio = NaN
+        next(iter(f["shapes"].values())).attrs["isoperimetric_ratio"] = np.nan
+    r = subprocess.run([sys.executable, script, "check", bad], capture_output=True, text=True)
+    check(r.returncode != 0 and "@isoperimetric_ratio: NaN/Inf attribute" in r.stdout,
+          "check names an attribute holding a NaN")
     os.remove(first)
     r = subprocess.run([sys.executable, script, "check", bad], capture_output=True, text=True)
     check(r.returncode != 0 and "missing" in r.stdout, "check fails when a shard is missing")
@@ -372,6 +378,11 @@ with tempfile.TemporaryDirectory() as work:
             metrics(hd.open_dataset(paths[name]))
         torch_part([paths["t2d"], paths["t3d"]])
         cli(paths["t2d"], work)
+        r = subprocess.run([sys.executable, script, "check", paths["t3d"]], capture_output=True, text=True)
+        with h5py.File(os.path.join(paths["t3d"], "shards", "shard-000000.h5")) as f:
+            iso = [g.attrs["isoperimetric_ratio"] for g in f["shapes"].values()]
+        check(r.returncode == 0 and all(0 < v <= 1 for v in iso),
+              f"3D: check passes, every attribute finite (isoperimetric ratio 36 pi V^2 / S^3 = {iso})")
 
 print("all checks passed" if not checks.failures else f"{checks.failures} checks failed")
 sys.exit(1 if checks.failures else 0)

@@ -123,6 +123,11 @@ const std::vector<Preset>& presets();
 DatasetConfig parse_dataset_file(const std::string& path);
 DatasetConfig parse_dataset_text(const std::string& text, const std::string& source,
                                  const std::string& base_dir = ".");
+/// The dataset's meaning: every resolved value (preset merged, defaults filled in, paths
+/// absolute, PETSc options sorted) in a fixed order. Two configs that differ only in layout,
+/// key order, comments or defaults written out have the same canonical text; its digest is the
+/// dataset's identity (`config_hash` in shards and manifest).
+std::string canonical_text(const DatasetConfig& config);
 /// The embedded default dataset: a small Random2D slice (a minute on a laptop).
 const char* default_dataset_text();
 

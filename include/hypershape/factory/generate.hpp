@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "hypershape/config/dataset.hpp"
 
@@ -30,6 +31,9 @@ struct GenerateOptions {
   int task_index = 0, task_count = 1;  ///< SLURM array slice
   int group_size = 1;                  ///< ranks per shape
   double progress_seconds = 10;        ///< interval of the progress line (0: none)
+  bool force = false;                  ///< write a dataset above the size bound / the free space
+  /// PETSc options given on the command line (names with one dash), checked before any work.
+  std::vector<std::string> petsc_command_line;
 };
 
 struct RunReport {
@@ -44,8 +48,11 @@ struct RunReport {
   bool indexed = false;                          ///< manifest written (dataset complete)
 };
 
-/// Collective over `comm`. Throws core::InputError (before any work) for an unusable output
-/// directory or one that holds another dataset.
+/// Collective over `comm`. Throws core::InputError (before anything is written) for bad PETSc
+/// options, a dataset too large for the bound or the free space (unless options.force), an
+/// unusable output directory, one that holds another dataset (by meaning:
+/// config::canonical_text), or one another run is writing (factory::OutputLock). A resume keeps
+/// only the shards that pass verification (factory::shard_problem) and redoes the rest.
 RunReport generate(MPI_Comm comm, const config::DatasetConfig& config, const GenerateOptions& options);
 
 /// The report as a short table (rank 0).

@@ -18,7 +18,8 @@ double enclosed_measure(const Boundary& b);
 double boundary_measure(const Boundary& b);
 
 /// 4 pi A / P^2 for a polygon: 1 for a disk, (pi/n)/tan(pi/n) for a regular n-gon, pi/4 for a
-/// square. Throws std::invalid_argument unless `b.dim == 2`.
+/// square; 36 pi V^2 / S^3 for a closed surface (1 for a ball, pi/6 for a cube). Throws
+/// std::invalid_argument unless `b.dim` is 2 or 3.
 double isoperimetric_ratio(const Boundary& b);
 
 /// One-sided Hausdorff distance sup_{x in from} dist(x, to) between two boundaries of the same
@@ -73,7 +74,7 @@ std::vector<double> exterior_radii(const Boundary& b);
 struct ShapeMetrics {
   double measure = 0;                  ///< enclosed area (2D) / volume (3D)
   double boundary_measure = 0;         ///< perimeter (2D) / surface area (3D)
-  double isoperimetric_ratio = 0;      ///< 4 pi A / P^2 in 2D; NaN in 3D
+  double isoperimetric_ratio = 0;      ///< 4 pi A / P^2 in 2D, 36 pi V^2 / S^3 in 3D (1: disk, ball)
   double hausdorff_to_base = 0;        ///< symmetric Hausdorff distance to the base; NaN if none
   std::int64_t n_boundary_facets = 0;  ///< segments (2D) / triangles (3D)
   double min_local_feature_size = 0;   ///< min over points of inscribed_radii()

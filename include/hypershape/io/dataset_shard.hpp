@@ -4,8 +4,10 @@
 /// only once complete and synced, so a shard on disk is either whole or absent (FACTS.md: a
 /// kill while growing one HDF5 file lost the file). The layout is in docs/FORMAT.md.
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <variant>
 #include <vector>
@@ -50,8 +52,17 @@ struct ShardHeader {
   std::map<std::string, std::string> software;
 };
 
+/// A shard could not be written (a full disk, an I/O error). Its temporary file is gone, but
+/// HDF5 1.10.8 may still hold the file and crash at library shutdown (measured: exit 139 in
+/// H5F__close_cb after a failed flush), so a driver ends the process without HDF5's shutdown.
+class StorageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 /// Writes one shard: add() each shape in order, then commit(). Destroying an uncommitted
-/// writer removes the temporary file. Not collective.
+/// writer removes the temporary file. A failed write (a full disk) removes it too and throws
+/// StorageError naming the file and the free space; HDF5 prints nothing. Not collective.
 class ShardWriter {
  public:
   /// Creates `path` + ".tmp" (truncating a stale one). Throws std::runtime_error.
@@ -60,10 +71,14 @@ class ShardWriter {
   ShardWriter(const ShardWriter&) = delete;
   ShardWriter& operator=(const ShardWriter&) = delete;
   void add(const ShardShape& shape);
-  /// Marks the shard complete, closes and fsyncs it, and renames it to `path`.
-  void commit();
+  /// Marks the shard complete, closes and fsyncs it, calls `before_rename(crc32, bytes)` of
+  /// the finished file (to record its checksum), and renames it to `path`.
+  void commit(const std::function<void(std::uint32_t crc32, std::uint64_t bytes)>& before_rename = {});
 
  private:
+  void write_header(const ShardHeader& header);
+  void add_shape(const ShardShape& shape);
+  void close_file();
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
@@ -84,9 +99,9 @@ struct ShardSummary {
 /// Reads the header and the per-shape summaries. Throws std::runtime_error if the file is not
 /// a complete shard of this format.
 ShardSummary read_shard_summary(const std::string& path);
-/// True if `path` is a complete shard of the given config (hash); false if absent, foreign or
-/// damaged (never throws).
-bool is_complete_shard(const std::string& path, const std::string& config_hash);
+/// Reads the header attributes only (config_text not read). Throws std::runtime_error if the
+/// file is not a complete shard of this format; HDF5 prints nothing.
+ShardHeader read_shard_header(const std::string& path);
 /// CRC-32 (zlib) of a file's bytes.
 std::uint32_t file_crc32(const std::string& path);
 /// A stable 64-bit digest (hex) of a text (FNV-1a), for config identity.

@@ -1,0 +1,66 @@
+#include <fmt/format.h>
+
+#include <algorithm>
+
+#include "hypershape/config/dataset.hpp"
+#include "hypershape/config/scene.hpp"
+
+namespace hypershape::config {
+
+namespace {
+
+std::string num(double v) { return fmt::format("{:.17g}", v); }
+
+std::string shapes_text(const DatasetConfig& c) {
+  const auto& s = c.shapes;
+  std::string t = fmt::format("shapes:\n  count: {}\n  dim: {}\n  base: {}\n  base_file: '{}'\n  base_dir: '{}'\n",
+                              c.n_shapes, s.dim, s.base, s.base_file, s.base_dir);
+  for (const auto& f : s.base_files) t += fmt::format("  - file: '{}'\n", f);
+  t += "  steps: [";
+  for (const auto& st : s.deformation.steps) t += fmt::format("[{}, {}], ", num(st.sigma), num(st.m));
+  t += "]\n";
+  t += fmt::format("  velocity_unit: {}\n  nodes_per_sigma: {}\n  margin_sigmas: {}\n",
+                   num(s.deformation.velocity_unit), num(s.deformation.nodes_per_sigma),
+                   num(s.deformation.margin_sigmas));
+  t += fmt::format("  h: {}\n  mesh_h: {}\n  dirichlet_radius: {}\n  max_turn_deg: {}\n  min_feature_fraction: {}\n",
+                   num(s.h), num(s.mesh_h), num(s.dirichlet_radius), num(s.max_turn_deg),
+                   num(s.min_feature_fraction));
+  t += fmt::format("  size_grading: {}\n  max_attempts: {}\n  quality: [{}, {}]\n", num(s.size_grading),
+                   s.max_attempts, num(s.quality.min_angle_deg), num(s.quality.min_shape));
+  return t;
+}
+
+std::string solver_text(const solver::SolverOptions& s) {
+  return fmt::format(
+      "solver:\n  rtol: {}\n  atol: {}\n  control: {}\n  path_rtol: {}\n  newton_budget: {}\n  fallback: {}\n"
+      "  branch_switches: {}\n  max_halvings: {}\n  max_newton: {}\n  factor_reuse: {}\n  krylov_budget: {}\n"
+      "  krylov_rtol: {}\n  max_increments: {}\n  min_increment: {}\n  guard: {}\n  target_rtol: {}\n"
+      "  max_target_solves: {}\n",
+      num(s.rtol), num(s.atol), int(s.control), num(s.path_rtol), s.newton_budget, s.fallback, s.branch_switches,
+      s.max_halvings, s.max_newton, s.tangent.reuse, s.tangent.krylov_budget, num(s.tangent.krylov_rtol),
+      s.max_increments, num(s.min_increment), s.guard, num(s.target_rtol), s.max_target_solves);
+}
+
+}  // namespace
+
+std::string canonical_text(const DatasetConfig& c) {
+  std::string t = fmt::format("# hypershape dataset identity (every resolved value)\nname: {}\nseed: {}\n", c.name,
+                              c.seed);
+  t += shapes_text(c);
+  t += fmt::format("loads:\n  count: {}\n  target: [{}, {}]\n", c.loads.count, num(c.loads.target_min),
+                   num(c.loads.target_max));
+  t += "scene:\n" + effects_yaml(c.scene) + "\n";
+  const auto& r = c.representations;
+  t += fmt::format("degree: {}\nrepresentations: [{}, {}, {}]\nsplit: [{}, {}, {}]\nshard_size: {}\n", c.degree,
+                   r.point_cloud, r.grid, r.grid_size, num(c.split.train), num(c.split.val), num(c.split.test),
+                   c.shard_size);
+  t += solver_text(c.solver);
+  // PETSc options in a fixed order (the order they are written in does not matter).
+  auto petsc = c.petsc;
+  std::sort(petsc.begin(), petsc.end());
+  t += "petsc:\n";
+  for (const auto& [k, v] : petsc) t += fmt::format("  '{}': '{}'\n", k, v);
+  return t;
+}
+
+}  // namespace hypershape::config
