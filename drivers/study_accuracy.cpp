@@ -68,7 +68,8 @@
 #include <tuple>
 #include <vector>
 
-#include "driver_support.hpp"
+#include "hypershape/study/machine.hpp"
+#include "hypershape/study/output.hpp"
 #include "hypershape/config/dataset.hpp"
 #include "hypershape/core/error.hpp"
 #include "hypershape/core/petsc_handle.hpp"
@@ -810,7 +811,7 @@ double mean_of(const std::vector<double>& v) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  auto [ours, petsc] = hs::drivers::split_at_dashes(argc, argv);
+  auto [ours, petsc] = hs::study::split_at_dashes(argc, argv);
   Args a;
   CLI::App app{"The accuracy/time study (docs/ACCURACY.md). Arguments after \"--\" go to PETSc."};
   auto* tiny = app.add_flag("--tiny", a.tiny, "CI version: the disk, P1/P2 at coarse h, a coarse reference, 1 load case");
@@ -842,7 +843,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }
-  if (!hs::drivers::output_writable(a.out, "--out") || !hs::drivers::output_writable(a.dump, "--dump")) return 2;
+  if (!hs::study::output_writable(a.out, "--out") || !hs::study::output_writable(a.dump, "--dump")) return 2;
   if (a.repeats < 0) a.repeats = a.tiny ? 1 : 3;
   if (a.ref_h2d < 0) a.ref_h2d = 0.02;
   if (a.ref_h3d < 0) a.ref_h3d = 0.2;
@@ -877,7 +878,7 @@ int main(int argc, char** argv) {
     json out;
     out["study"] = "study_accuracy";
     out["mode"] = a.tiny ? "tiny" : "full";
-    out["machine"] = hs::drivers::machine_note();
+    out["machine"] = hs::study::machine_note();
     out["load_average_start"] = load_average();
     out["parameters"] = {{"repeats", a.repeats},
                          {"repeat_above_seconds", a.repeat_above},
@@ -1153,7 +1154,7 @@ int main(int argc, char** argv) {
                           {"u_hat", at_ref[l]},
                           {"rel_l2", e2},
                           {"rel_h1", e1}};
-                  hs::drivers::write_json_atomic(a.dump, dj, "--dump", 1);
+                  hs::study::write_json_atomic(a.dump, dj, "--dump", 1);
                   dumped = true;
                 }
               }
@@ -1199,7 +1200,7 @@ int main(int argc, char** argv) {
       out["scenes"].push_back(sc);
       out["seconds_total"] = hs::core::now_seconds() - t_all;
       out["load_average_end"] = load_average();
-      hs::drivers::write_json_atomic(a.out, out, "--out", 1);
+      hs::study::write_json_atomic(a.out, out, "--out", 1);
     }
     print_table(std::cout, out);
     std::cout << fmt::format("\ntotal {:.1f} s on {} ({} cores, {}); load average at start {}, end {}\n",
