@@ -185,12 +185,7 @@ void run_preset(const ShapeBenchOptions& set, const config::DatasetConfig& cfg, 
 }
 
 json to_json(const PresetRecord& r) {
-  json j;
-  j["file"] = r.file;
-  j["name"] = r.name;
-  j["dim"] = r.dim;
-  j["h"] = r.h;
-  j["repeats"] = r.repeats;
+  json j{{"file", r.file}, {"name", r.name}, {"dim", r.dim}, {"h", r.h}, {"repeats", r.repeats}};
   json ms = json::object(), mv = json::object(), ss = json::object(), sv = json::object();
   for (const auto& [k, xs] : r.seconds) {
     ms[k] = number_or_null(median(xs));
