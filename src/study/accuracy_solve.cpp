@@ -50,26 +50,23 @@ void rotate_load(factory::LoadCase& lc, double angle) {
 }
 
 /// The small-strain model: u_lin = alpha_lin K(0)^-1 f_ext with alpha_lin = target /
-/// max|K(0)^-1 f_ext| (one factorisation of the tangent at u = 0 and one solve, on the
-/// solver's KSP), in `du`.
+/// max|K(0)^-1 f_ext| (NonlinearSolver::linear_response: one factorisation of the tangent at
+/// u = 0 and one solve, on the solver's KSP), in `du`.
 void linear_model(solver::NonlinearSolver& nl, const physics::Problem& problem, double target, Vec du,
                   LoadOutcome& lo) {
-  Mat J = nl.jacobian_matrix();
-  KSP ksp;
-  HS_PETSC(SNESGetKSP(nl.snes(), &ksp));
-  lo.converged = problem.jacobian(nl.solution(), J);
-  if (!lo.converged) {
+  const std::optional<double> m = nl.linear_response(du);
+  if (!m) {
+    lo.converged = false;
     lo.reason = "tangent at u = 0 not formed";
     return;
   }
-  HS_PETSC(KSPSetOperators(ksp, J, J));
-  HS_PETSC(KSPSolve(ksp, problem.load(), du));
+  KSP ksp;
+  HS_PETSC(SNESGetKSP(nl.snes(), &ksp));
   KSPConvergedReason why;
   HS_PETSC(KSPGetConvergedReason(ksp, &why));
-  const double m = problem.max_displacement(du);
-  lo.converged = why > 0 && m > 0 && std::isfinite(m);
+  lo.converged = why > 0 && *m > 0 && std::isfinite(*m);
   lo.reason = KSPConvergedReasons[why];
-  lo.alpha = target / m;
+  lo.alpha = target / *m;
   HS_PETSC(VecScale(du, lo.alpha));
   lo.max_u = problem.max_displacement(du);
   lo.solves = 1;
