@@ -241,14 +241,18 @@ SolveResult NonlinearSolver::solve(double target) {
 }
 
 double NonlinearSolver::linear_response() {
+  core::VecH du = problem_.create_vector();
+  return linear_response(du).value_or(0.0);
+}
+
+std::optional<double> NonlinearSolver::linear_response(Vec du) {
   HS_PETSC(VecCopy(u_, backup_));
   ++snes_linear_.tangent_assemblies;
-  if (!problem_.jacobian(u_, J_)) return 0.0;
+  if (!problem_.jacobian(u_, J_)) return std::nullopt;
   ++snes_linear_.numeric_factorizations;
   KSP ksp;
   HS_PETSC(SNESGetKSP(snes_, &ksp));
   HS_PETSC(KSPSetOperators(ksp, J_, J_));
-  core::VecH du = problem_.create_vector();
   HS_PETSC(KSPSolve(ksp, problem_.load(), du));
   return problem_.max_displacement(du);
 }

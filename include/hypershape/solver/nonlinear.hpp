@@ -47,6 +47,7 @@
 #include <petscsnes.h>
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -136,6 +137,11 @@ class NonlinearSolver {
   TargetResult solve_for_target(double target);
   /// max|u| of the linear response to the nominal load at the current state (one linear solve).
   double linear_response();
+  /// The linear response du = K(u)^-1 f_ext at the current state u (the tangent assembled into
+  /// jacobian_matrix() and solved on the SNES's KSP, which keeps the solve's converged reason),
+  /// in `du` (a vector of the problem); returns max|du|, or nothing if the tangent cannot be
+  /// formed at u. Collective.
+  std::optional<double> linear_response(Vec du);
 
   SNES snes() const { return snes_.get(); }
   Mat jacobian_matrix() const { return J_.get(); }
