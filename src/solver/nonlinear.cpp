@@ -620,6 +620,48 @@ void NonlinearSolver::switch_branch(double target, double start, int attempt, Ta
   t = p;
 }
 
+bool NonlinearSolver::increment(double d_next, bool last, int& its, std::string& why) {
+  // Tangent predictor to c . u = d_next: from an equilibrium at s, dalpha a is Newton's step
+  // at the load s + dalpha. Taken with the guarded energy line search: never an inverted
+  // state, and damped where a linearised large rotation would stretch a nearly
+  // incompressible body. (Shortening the increment to the damped length instead cost more
+  // increments than it saved: measured on Random2D draws.)
+  const double m = control_direction(u_, a_, c_);
+  PetscReal ca;
+  HS_PETSC(VecDot(c_, a_, &ca));
+  // c . a = d max|u| / d alpha along the path; negative past a limit point of the load (the
+  // path goes on at a falling load: displacement control passes limit points).
+  if (!(std::isfinite(ca) && ca != 0.0)) {
+    why = "singular tangent: max|u| does not respond to the load";
+    return false;
+  }
+  const double dalpha = (d_next - m) / ca;
+  const double s_pred = s_ + dalpha;
+  if (!problem_.residual(u_, s_pred, r_)) throw std::logic_error("a converged state is inadmissible");
+  HS_PETSC(VecAXPBY(du_, -dalpha, 0.0, a_));  // Y = -dalpha a
+  const double lambda = backtrack(u_, du_, r_, s_pred, w_, b_);
+  if (lambda > 0.0) {
+    HS_PETSC(VecCopy(w_, u_));
+    s_ += lambda * dalpha;
+  }
+  return correct(d_next, last ? opt_.rtol : opt_.path_rtol, its, why);
+}
+
+void NonlinearSolver::finish_path(TargetResult& t, bool at_target) {
+  t.max_displacement = problem_.max_displacement(u_);
+  t.alpha = s_;
+  t.negative_pivots = negative_pivots_;
+  t.converged = at_target && !(negative_pivots_ > 0);
+  if (t.converged) {
+    // Leave the SNES as a load-controlled solve would (set up, callbacks at this load); at a
+    // converged state this is one residual evaluation and zero Newton iterations.
+    SolveResult check;
+    t.converged = newton(s_, check);
+    t.newton_iterations += check.newton_iterations;
+    t.reason = t.converged ? "target reached" : "final check: " + check.reason;
+  }
+}
+
 TargetResult NonlinearSolver::follow_path(double target, double start, int spent) {
   TargetResult t;
   if (!(target > 0) || !std::isfinite(target)) {
@@ -656,30 +698,7 @@ TargetResult NonlinearSolver::follow_path(double target, double start, int spent
     const double s_backup = s_;
     const int its_before = its;
     ++t.solves;
-    // Tangent predictor to c . u = d_next: from an equilibrium at s, dalpha a is Newton's step
-    // at the load s + dalpha. Taken with the guarded energy line search: never an inverted
-    // state, and damped where a linearised large rotation would stretch a nearly
-    // incompressible body. (Shortening the increment to the damped length instead cost more
-    // increments than it saved: measured on Random2D draws.)
-    const double m = control_direction(u_, a_, c_);
-    PetscReal ca;
-    HS_PETSC(VecDot(c_, a_, &ca));
-    // c . a = d max|u| / d alpha along the path; negative past a limit point of the load (the
-    // path goes on at a falling load: displacement control passes limit points).
-    bool ok = std::isfinite(ca) && ca != 0.0;
-    if (!ok) why = "singular tangent: max|u| does not respond to the load";
-    if (ok) {
-      const double dalpha = (d_next - m) / ca;
-      const double s_pred = s_backup + dalpha;
-      if (!problem_.residual(u_, s_pred, r_)) throw std::logic_error("a converged state is inadmissible");
-      HS_PETSC(VecAXPBY(du_, -dalpha, 0.0, a_));  // Y = -dalpha a
-      const double lambda = backtrack(backup_, du_, r_, s_pred, w_, b_);
-      if (lambda > 0.0) {
-        HS_PETSC(VecCopy(w_, u_));
-        s_ = s_backup + lambda * dalpha;
-      }
-      ok = correct(d_next, last ? opt_.rtol : opt_.path_rtol, its, why);
-    }
+    const bool ok = increment(d_next, last, its, why);
     if (t.solves == 1) t.seconds_first_solve = core::now_seconds() - start;
     HS_PETSC(PetscInfo(snes_.get(), "path to %g: %g -> %g%s: %s in %d Newton its (alpha %g)\n", target, d, d_next,
                        last ? " (last)" : "", ok ? "converged" : why.c_str(), its - its_before, s_));
@@ -727,18 +746,7 @@ TargetResult NonlinearSolver::follow_path(double target, double start, int spent
     }
   }
   t.newton_iterations = its - spent;
-  t.max_displacement = problem_.max_displacement(u_);
-  t.alpha = s_;
-  t.negative_pivots = negative_pivots_;
-  t.converged = d == target && !(negative_pivots_ > 0);
-  if (t.converged) {
-    // Leave the SNES as a load-controlled solve would (set up, callbacks at this load); at a
-    // converged state this is one residual evaluation and zero Newton iterations.
-    SolveResult check;
-    t.converged = newton(s_, check);
-    t.newton_iterations += check.newton_iterations;
-    t.reason = t.converged ? "target reached" : "final check: " + check.reason;
-  }
+  finish_path(t, d == target);
   return t;
 }
 

@@ -136,7 +136,7 @@ void check_objectivity() {
     const Tensor<D> F = random_f<D>(rng), Q = random_rotation<D>(rng);
     REQUIRE(std::abs(Q.determinant() - 1.0) < 1e-12);
     REQUIRE((Q.transpose() * Q - Tensor<D>::Identity()).norm() < 1e-12);
-    double W, WQ;
+    double W = 0, WQ = 0;
     Tensor<D> P, PQ;
     REQUIRE(m.energy(F, W));
     REQUIRE(m.energy(Q * F, WQ));
@@ -145,7 +145,7 @@ void check_objectivity() {
     CHECK(std::abs(WQ - W) <= 1e-12 * std::abs(W));
     CHECK((PQ - Q * P).norm() <= 1e-12 * P.norm());
     // A rigid rotation alone stores no energy and no stress.
-    double WR;
+    double WR = 0;
     Tensor<D> PR;
     REQUIRE(m.energy(Q, WR));
     REQUIRE(m.stress(Q, PR));
@@ -202,7 +202,7 @@ TEST_CASE("Neo-Hookean energy has the closed form on a diagonal stretch", "[kern
   F2.diagonal() << a, b;
   Tensor<3> F3 = Tensor<3>::Identity();
   F3.topLeftCorner<2, 2>() = F2;
-  double W2, W3;
+  double W2 = 0, W3 = 0;
   REQUIRE(m2.energy(F2, W2));
   REQUIRE(m.energy(F3, W3));
   CHECK(W2 == Approx(W3).epsilon(1e-14));

@@ -14,7 +14,7 @@ namespace {
 
 physics::EffectSpec effect(const std::string& name, std::map<std::string, physics::ParamValue> p,
                            bool scaled = true) {
-  return {name, name, "effects." + name, std::move(p), scaled, !scaled};
+  return {name, name, "effects." + name, std::move(p), scaled, !scaled, {}, 0};
 }
 
 /// The clamped disk with a Gaussian traction (scaled) and gravity, scaled or fixed.

@@ -161,6 +161,12 @@ class NonlinearSolver {
   /// Displacement control from the current state to max|u| = target; `spent`: Newton
   /// iterations the target solve spent before (counted against newton_budget).
   TargetResult follow_path(double target, double start, int spent = 0);
+  /// One increment of the path from the equilibrium in u_/s_ to max|u| = d_next: the tangent
+  /// predictor (a_ holds K^-1 f_ext there) and the corrector, to rtol if `last`, else path_rtol.
+  bool increment(double d_next, bool last, int& its, std::string& why);
+  /// The path's result from the state it ended in (`at_target`: its last increment reached
+  /// the target): max|u|, alpha, inertia, and the converged state's final check.
+  void finish_path(TargetResult& t, bool at_target);
   /// One corrector: Newton on (u, alpha) for max|u| = d (or alpha fixed when d < 0) from the
   /// current iterate in u_/s_; returns false with `why` set on failure. Leaves in `a_` the
   /// tangent response K^-1 f_ext of its last factorisation (the next predictor).
