@@ -30,6 +30,60 @@ load: {target: 0.3}
 )";
 }
 
+namespace {
+
+/// polygon: [[x, y], ...]: at least 3 points of 2 finite numbers each.
+void parse_polygon(const YamlBlock& geo, Scene& s) {
+  const YAML::Node n = geo.get("polygon");
+  if (!n.IsSequence() || n.size() < 3) geo.fail("polygon", "must be a list of >= 3 points [x, y]");
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    const std::string key = "polygon[" + std::to_string(i) + "]";
+    if (!n[i].IsSequence() || n[i].size() != 2) geo.fail(key, "must be a point [x, y]");
+    std::array<double, 2> p{};
+    for (std::size_t k = 0; k < 2; ++k) {
+      try {
+        p[k] = n[i][k].as<double>();
+      } catch (const YAML::Exception&) {
+        geo.fail(key, "must be a point [x, y] of numbers");
+      }
+      if (!std::isfinite(p[k])) geo.fail(key, "must be a point [x, y] of finite numbers");
+    }
+    s.polygon.push_back(p);
+  }
+}
+
+void parse_geometry(const YamlBlock& geo, const std::string& base_dir, Scene& s) {
+  if (geo.has("polygon")) {
+    if (geo.has("base")) geo.fail("base", "give either base or polygon");
+    s.base = "polygon";
+    s.dim = 2;
+    parse_polygon(geo, s);
+    geo.allowed("base, file, polygon");
+    geo.check_all_used();
+    return;
+  }
+  s.base = geo.text("base");
+  if (s.base == "circle") {
+    s.dim = 2;
+  } else if (s.base == "sphere") {
+    s.dim = 3;
+  } else if (s.base == "file") {
+    namespace fs = std::filesystem;
+    fs::path p = geo.text("file");
+    if (p.is_relative()) p = fs::path(base_dir) / p;
+    std::error_code ec;
+    if (!fs::is_regular_file(p, ec)) geo.fail("file", "no such mesh file: " + p.string());
+    s.mesh_file = p.string();
+    s.dim = 0;
+  } else {
+    geo.fail("base", "unknown base shape '" + s.base + "'; allowed: circle, sphere, file (or polygon: [[x, y], ...])");
+  }
+  geo.allowed("base, file, polygon");
+  geo.check_all_used();
+}
+
+}  // namespace
+
 Scene parse_scene_text(const std::string& text, const std::string& source, const std::string& base_dir) {
   YAML::Node root;
   try {
@@ -49,31 +103,14 @@ Scene parse_scene_text(const std::string& text, const std::string& source, const
       top.fail(kv.first.Scalar(), "unknown key; allowed: geometry, mesh, effects, load, solver, petsc");
   }
 
-  YamlBlock geo(top.get("geometry"), source, "geometry");
   if (!top.has("geometry")) top.fail("geometry", "missing (e.g. geometry: {base: circle})");
-  s.base = geo.text("base");
-  if (s.base == "circle") {
-    s.dim = 2;
-  } else if (s.base == "sphere") {
-    s.dim = 3;
-  } else if (s.base == "file") {
-    namespace fs = std::filesystem;
-    fs::path p = geo.text("file");
-    if (p.is_relative()) p = fs::path(base_dir) / p;
-    std::error_code ec;
-    if (!fs::is_regular_file(p, ec)) geo.fail("file", "no such mesh file: " + p.string());
-    s.mesh_file = p.string();
-    s.dim = 0;
-  } else {
-    geo.fail("base", "unknown base shape '" + s.base + "'; allowed: circle, sphere, file");
-  }
-  geo.allowed("base, file");
-  geo.check_all_used();
+  parse_geometry(YamlBlock(top.get("geometry"), source, "geometry"), base_dir, s);
 
   YamlBlock mesh(top.get("mesh"), source, "mesh");
   if (mesh.has("h")) {
     s.h = mesh.number("h");
-    if (!(s.h > 0 && s.h <= 1)) mesh.fail("h", "must be in (0, 1]");
+    if (s.base == "polygon" ? !(s.h > 0) : !(s.h > 0 && s.h <= 1))
+      mesh.fail("h", s.base == "polygon" ? "must be > 0 (in the polygon's length unit)" : "must be in (0, 1]");
   }
   if (mesh.has("degree")) {
     s.degree = int(mesh.integer("degree"));
