@@ -14,6 +14,7 @@
 #include "hypershape/physics/mooney_rivlin.hpp"
 #include "hypershape/physics/saint_venant_kirchhoff.hpp"
 #include "support/helpers.hpp"
+#include "support/kernel_checks.hpp"
 
 using namespace hypershape;
 using namespace hypershape::physics;
@@ -45,26 +46,9 @@ LinearElastic<D> le(double nu = NU) {
 
 template <int D>
 Tensor<D> random_f(std::mt19937_64& rng) {
-  std::uniform_real_distribution<double> u(-0.35, 0.35);
-  for (;;) {
-    Tensor<D> F = Tensor<D>::Identity();
-    for (int i = 0; i < D; ++i)
-      for (int j = 0; j < D; ++j) F(i, j) += u(rng);
-    if (F.determinant() > 0.3) return F;
-  }
+  return hstest::random_f<D>(rng, 0.35, 0.3);
 }
-
-/// 4th-order central difference of fn(F) in direction E_kl.
-template <int D, class Fn>
-auto fd4(Fn&& fn, const Tensor<D>& F, int k, int l, double h) {
-  using Value = std::decay_t<decltype(fn(F))>;
-  auto at = [&](double t) -> Value {
-    Tensor<D> G = F;
-    G(k, l) += t;
-    return fn(G);
-  };
-  return Value((-at(2 * h) + 8.0 * at(h) - 8.0 * at(-h) + at(-2 * h)) / (12.0 * h));
-}
+using hstest::fd4;
 
 template <int D, class K>
 void check_derivatives(const K& m, const char* name) {
@@ -118,13 +102,8 @@ void check_reference_state(const K& m, double nu) {
 template <int D, class K>
 void check_objectivity(const K& m) {
   std::mt19937_64 rng(5 + D);
-  std::normal_distribution<double> n;
   for (int sample = 0; sample < 6; ++sample) {
-    Tensor<D> M;
-    for (int i = 0; i < D; ++i)
-      for (int j = 0; j < D; ++j) M(i, j) = n(rng);
-    Tensor<D> Q = Eigen::HouseholderQR<Tensor<D>>(M).householderQ();
-    if (Q.determinant() < 0) Q.col(0) *= -1.0;
+    const Tensor<D> Q = hstest::random_rotation<D>(rng);
     const Tensor<D> F = random_f<D>(rng);
     double W, WQ;
     Tensor<D> P, PQ;

@@ -32,8 +32,9 @@ void register_dirichlet_region() {
         static std::atomic<int> n_made{0};  // each instance its own label
         return make_dirichlet("dirichlet_" + std::to_string(n_made++), r.facets(), components(p, dim));
       },
-      std::string("u_i = 0 on the boundary in a region (a clamped edge); keys: ") + region_help() +
-          " (required), components (list of indices, default all)");
+      "u_i = 0 on the boundary facets in a region (a clamped edge; a roller with one component); keys: "
+      "box [lower corner, upper corner] or center + radius (required), components (list of indices, "
+      "default all)");
 }
 
 }  // namespace hypershape::physics
