@@ -3,10 +3,13 @@
 /// Lame's closed form (linear elasticity, and Neo-Hookean at a small load), a uniform traction's
 /// total force, and the effects' keys.
 #include <catch2/catch.hpp>
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
 #include "hypershape/core/error.hpp"
+#include "hypershape/physics/neo_hookean.hpp"
 #include "support/helpers.hpp"
 
 using namespace hypershape;
@@ -85,7 +88,84 @@ std::pair<double, double> cylinder_error(physics::EffectPtr material, double p, 
   return lame_error(*pb, ns.solution(), p, E, nu);
 }
 
+/// Neo-Hookean principal nominal stress P_i at principal stretches (l_i, l_other), plane strain.
+double nh_principal(double li, double lo, double mu, double lambda) {
+  return mu * (li - 1 / li) + lambda * std::log(li * lo) / li;
+}
+
+/// The radial BVP of the Neo-Hookean cylinder under a dead internal pressure p: r(R) on [a, b]
+/// with l_r = r', l_t = r / R, d P_r / dR = (P_t - P_r) / R, P_r(a) = -p, P_r(b) = 0. Shooting
+/// on r(a) (secant) with RK4 in R (n steps); returns u_r = r - R at n + 1 equispaced R.
+std::vector<double> radial_bvp(double p, double mu, double lambda, int n) {
+  auto stretch_r = [&](double P, double lt) {  // l_r with P_r(l_r, l_t) = P, by Newton
+    double l = 1.0;
+    for (int it = 0; it < 50; ++it) {
+      const double g = nh_principal(l, lt, mu, lambda) - P;
+      const double dg = mu * (1 + 1 / (l * l)) + lambda * (1 - std::log(l * lt)) / (l * l);
+      l -= g / dg;
+      if (std::abs(g) < 1e-13 * (mu + lambda)) break;
+    }
+    return l;
+  };
+  auto rhs = [&](double R, const std::array<double, 2>& y) {  // y = (r, P_r)
+    const double lt = y[0] / R, lr = stretch_r(y[1], lt);
+    return std::array<double, 2>{lr, (nh_principal(lt, lr, mu, lambda) - y[1]) / R};
+  };
+  auto shoot = [&](double ra, std::vector<double>* u) {
+    std::array<double, 2> y{ra, -p};
+    const double dR = (b_out - a_in) / n;
+    for (int i = 0; i < n; ++i) {
+      const double R = a_in + i * dR;
+      if (u) u->push_back(y[0] - R);
+      auto add = [&](const std::array<double, 2>& k, double f) { return std::array<double, 2>{y[0] + f * k[0], y[1] + f * k[1]}; };
+      const auto k1 = rhs(R, y), k2 = rhs(R + dR / 2, add(k1, dR / 2)), k3 = rhs(R + dR / 2, add(k2, dR / 2)),
+                 k4 = rhs(R + dR, add(k3, dR));
+      for (int k = 0; k < 2; ++k) y[k] += dR / 6 * (k1[k] + 2 * k2[k] + 2 * k3[k] + k4[k]);
+    }
+    if (u) u->push_back(y[0] - b_out);
+    return y[1];  // P_r(b): zero at the solution
+  };
+  double r0 = a_in * 1.05, r1 = a_in * 1.1, f0 = shoot(r0, nullptr), f1 = shoot(r1, nullptr);
+  for (int it = 0; it < 60 && std::abs(f1) > 1e-12 * p; ++it) {
+    const double r2 = r1 - f1 * (r1 - r0) / (f1 - f0);
+    r0 = r1, f0 = f1, r1 = r2, f1 = shoot(r1, nullptr);
+  }
+  std::vector<double> u;
+  shoot(r1, &u);
+  return u;
+}
+
 }  // namespace
+
+TEST_CASE("Thick-walled cylinder at a finite pressure: the radial boundary-value problem", "[loads]") {
+  // Neo-Hookean, dead pressure p = 40 on the inner arc: u_r(a) / a ~ 0.09, far from linear.
+  const double E = 1000, nu = 0.3, p = 40.0;
+  const physics::Lame l = physics::Lame::from_young_poisson(E, nu);
+  const int n = 4000;
+  const std::vector<double> bvp = radial_bvp(p, l.mu, l.lambda, n);
+  auto pb = cylinder(physics::make_neo_hookean(E, nu), p, 2, 0.1);
+  solver::SolverOptions so;
+  so.rtol = 1e-12;
+  solver::NonlinearSolver ns(*pb, so);
+  REQUIRE(ns.solve(1.0).converged);
+  const physics::NodalField f = pb->gather(ns.solution());
+  const auto& X = pb->space().canonical_coords();
+  double err = 0, lame = 0;
+  for (std::size_t k = 0; 2 * k < f.values.size(); ++k) {
+    const double x = X[2 * k], y = X[2 * k + 1], R = std::hypot(x, y);
+    const double ur = (f.values[2 * k] * x + f.values[2 * k + 1] * y) / R;
+    const double s = std::clamp((R - a_in) / (b_out - a_in) * n, 0.0, double(n) - 1e-9);
+    const auto i = std::size_t(s);
+    const double exact = bvp[i] + (s - double(i)) * (bvp[i + 1] - bvp[i]);
+    err = std::max(err, std::abs(ur - exact) / bvp[0]);
+    lame = std::max(lame, std::abs(exact - lame_ur(R, p, E, nu)) / bvp[0]);
+  }
+  MPI_Bcast(&err, 1, MPI_DOUBLE, 0, PETSC_COMM_WORLD);
+  MPI_Bcast(&lame, 1, MPI_DOUBLE, 0, PETSC_COMM_WORLD);
+  INFO("u_r(a) = " << bvp[0] << ": max |u_r - BVP| / u_r(a) = " << err << "; the BVP differs from Lame by " << lame);
+  CHECK(lame > 0.02);  // a finite load: linear elasticity is far off
+  CHECK(err < 1e-3);
+}
 
 TEST_CASE("Thick-walled cylinder under internal pressure: Lame's solution", "[loads]") {
   const double E = 1000, nu = 0.3;
@@ -114,6 +194,21 @@ TEST_CASE("A uniform traction on a box region has the total force t times the ed
   const physics::Resultants r = pb.resultants(u, 1.0);
   CHECK(r.applied_force[0] == Approx(0.25).epsilon(1e-12));
   CHECK(r.applied_force[1] == Approx(-1.0).epsilon(1e-12));
+}
+
+TEST_CASE("In 3D a pressure on a face pushes along its inward normal", "[loads]") {
+  std::vector<physics::EffectPtr> e;
+  e.push_back(physics::make_linear_elastic(1000, 0.3));
+  e.push_back(physics::make_dirichlet("clamp", hstest::on_plane(0, 0.0)));
+  e.push_back(physics::make_pressure(2.0, physics::Region::box({1, 0, 0}, {1, 1, 1}), 3));
+  e.push_back(physics::make_pressure(0.5, physics::Region::box({0, 0, 1}, {1, 1, 1}), 3));
+  physics::Problem pb(PETSC_COMM_WORLD, mesh::mesh_box(3, 1.0, 0.4), std::move(e), hstest::degree(1));
+  core::VecH u = pb.create_vector();
+  HS_PETSC(VecZeroEntries(u));
+  const physics::Resultants r = pb.resultants(u, 1.0);
+  CHECK(r.applied_force[0] == Approx(-2.0).epsilon(1e-12));
+  CHECK(std::abs(r.applied_force[1]) < 1e-12);
+  CHECK(r.applied_force[2] == Approx(-0.5).epsilon(1e-12));
 }
 
 TEST_CASE("Loads and regions reject bad keys naming them", "[loads][input]") {
