@@ -50,8 +50,8 @@ ScalarFunction modulus_field(const core::Params& p, int dim) {
 }
 
 std::string modulus_field_help() {
-  return "; optional log-normal modulus field (mean E): E_cv >= 0, E_length > 0, E_seed (integer; "
-         "drawn per shape in a dataset)";
+  return "; optional log-normal modulus field m(x) (mean 1) scaling the moduli: E_cv >= 0, E_length > 0, "
+         "E_seed (integer; drawn per shape in a dataset)";
 }
 
 }  // namespace hypershape::physics

@@ -14,6 +14,7 @@
 
 #include "hypershape/core/params.hpp"
 #include "hypershape/physics/hyperelastic.hpp"
+#include "hypershape/physics/registry.hpp"
 
 namespace hypershape::physics {
 
@@ -40,5 +41,26 @@ class LogNormalField {
 ScalarFunction modulus_field(const core::Params& p, int dim);
 /// The keys above for a help line.
 std::string modulus_field_help();
+
+/// A material of kernel family K whose constants are (mu, lambda), from E and nu.
+template <template <int> class K>
+EffectPtr make_young_poisson_material(std::string name, double E, double nu, ScalarFunction field) {
+  const Lame l = Lame::from_young_poisson(E, nu);
+  const double c[2] = {l.mu, l.lambda};
+  return std::make_unique<HyperelasticEffect<K>>(std::move(name), K<2>::from_constants(c), K<3>::from_constants(c),
+                                                 std::move(field));
+}
+
+/// Registers such a material under `name` with keys E, nu and the modulus field's.
+template <template <int> class K>
+void register_young_poisson_material(const std::string& name, const std::string& help) {
+  register_effect(
+      name,
+      [name](const core::Params& p, int dim) {
+        const YoungPoisson m = young_poisson(p);
+        return make_young_poisson_material<K>(name, m.E, m.nu, modulus_field(p, dim));
+      },
+      help + "; keys: E > 0, nu in (-1, 0.5)" + modulus_field_help());
+}
 
 }  // namespace hypershape::physics
