@@ -228,12 +228,16 @@ class Dataset:
         self._status = None  # shape id -> (L,) int8, read on demand
         self.grid_size = None
         self.channels, self.scene_text = [], ""
+        self.channel_components = {}  # channel -> components (d for vectors, 1 for pressure, modulus)
         ok = self.shape_ids(include_failed=False)
         if ok:
             g = self._group(ok[0])
             if "grid/sdf" in g:
                 self.grid_size = int(g["grid/sdf"].shape[0])
             self.channels = _channels_of(g["loads"])
+            self.channel_components = {
+                c: int((g["loads"][c] if c in g["loads"] else g["loads"]["grid_" + c]).shape[-1])
+                for c in self.channels}
             f = self._file(self._shard_of(ok[0]))
             if "scene" in f:
                 self.scene_text = _text(f["scene"][()])

@@ -98,11 +98,13 @@ class _Base(torch.utils.data.Dataset):
         self.index = self.reader.keys(split)  # (shape_id, load_id), converged only
         sdf, dd, prefix, u = self._fields
         # Inputs: sdf, dirichlet distance, then every channel the dataset's effects bring
-        # (traction, body force, ...: Dataset.channels), d components each.
+        # (traction, body force, ...: Dataset.channels), d components each (pressure and a
+        # modulus field: one, named without a suffix).
         self.channels = list(self.reader.channels)
+        nc = {c: self.reader.channel_components.get(c, d) for c in self.channels}
         self.x_channels = ["sdf", "dirichlet_distance"] + [
-            f"{c}_{k}" for c in self.channels for k in "xyz"[:d]]
-        fields = [(sdf, 1), (dd, 1)] + [(prefix + c, d) for c in self.channels]
+            (f"{c}_{k}" if nc[c] > 1 else c) for c in self.channels for k in "xyz"[:nc[c]]]
+        fields = [(sdf, 1), (dd, 1)] + [(prefix + c, nc[c]) for c in self.channels]
         xm, xs = zip(*(_field_norm(self.reader, f, normalize, c) for f, c in fields))
         ym, ys = _field_norm(self.reader, u, normalize, d)
         self.x_mean = torch.tensor(np.concatenate(xm), dtype=dtype)

@@ -30,22 +30,38 @@ load: {target: 0.3}
 )";
 }
 
-Scene parse_scene_text(const std::string& text, const std::string& source, const std::string& base_dir) {
-  YAML::Node root = load_yaml(text, source);
-  if (!root || !root.IsMap()) throw InputError(source, "", "a scene must be a YAML mapping");
-  Scene s;
-  s.source = source;
-  s.text = text;
-  YamlBlock top(root, source, "");
-  top.allowed("geometry, mesh, effects, load, solver, petsc");
-  for (const auto& kv : root) {
-    static const std::set<std::string> sections = {"geometry", "mesh", "effects", "load", "solver", "petsc"};
-    if (!sections.count(kv.first.Scalar()))
-      top.fail(kv.first.Scalar(), "unknown key; allowed: geometry, mesh, effects, load, solver, petsc");
-  }
+namespace {
 
-  YamlBlock geo(top.get("geometry"), source, "geometry");
-  if (!top.has("geometry")) top.fail("geometry", "missing (e.g. geometry: {base: circle})");
+/// polygon: [[x, y], ...]: at least 3 points of 2 finite numbers each.
+void parse_polygon(const YamlBlock& geo, Scene& s) {
+  const YAML::Node n = geo.get("polygon");
+  if (!n.IsSequence() || n.size() < 3) geo.fail("polygon", "must be a list of >= 3 points [x, y]");
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    const std::string key = "polygon[" + std::to_string(i) + "]";
+    if (!n[i].IsSequence() || n[i].size() != 2) geo.fail(key, "must be a point [x, y]");
+    std::array<double, 2> p{};
+    for (std::size_t k = 0; k < 2; ++k) {
+      try {
+        p[k] = n[i][k].as<double>();
+      } catch (const YAML::Exception&) {
+        geo.fail(key, "must be a point [x, y] of numbers");
+      }
+      if (!std::isfinite(p[k])) geo.fail(key, "must be a point [x, y] of finite numbers");
+    }
+    s.polygon.push_back(p);
+  }
+}
+
+void parse_geometry(const YamlBlock& geo, const std::string& base_dir, Scene& s) {
+  if (geo.has("polygon")) {
+    if (geo.has("base")) geo.fail("base", "give either base or polygon");
+    s.base = "polygon";
+    s.dim = 2;
+    parse_polygon(geo, s);
+    geo.allowed("base, file, polygon");
+    geo.check_all_used();
+    return;
+  }
   s.base = geo.text("base");
   if (s.base == "circle") {
     s.dim = 2;
@@ -60,15 +76,36 @@ Scene parse_scene_text(const std::string& text, const std::string& source, const
     s.mesh_file = p.string();
     s.dim = 0;
   } else {
-    geo.fail("base", "unknown base shape '" + s.base + "'; allowed: circle, sphere, file");
+    geo.fail("base", "unknown base shape '" + s.base + "'; allowed: circle, sphere, file (or polygon: [[x, y], ...])");
   }
-  geo.allowed("base, file");
+  geo.allowed("base, file, polygon");
   geo.check_all_used();
+}
+
+}  // namespace
+
+Scene parse_scene_text(const std::string& text, const std::string& source, const std::string& base_dir) {
+  YAML::Node root = load_yaml(text, source);
+  if (!root || !root.IsMap()) throw InputError(source, "", "a scene must be a YAML mapping");
+  Scene s;
+  s.source = source;
+  s.text = text;
+  YamlBlock top(root, source, "");
+  top.allowed("geometry, mesh, effects, load, solver, petsc");
+  for (const auto& kv : root) {
+    static const std::set<std::string> sections = {"geometry", "mesh", "effects", "load", "solver", "petsc"};
+    if (!sections.count(kv.first.Scalar()))
+      top.fail(kv.first.Scalar(), "unknown key; allowed: geometry, mesh, effects, load, solver, petsc");
+  }
+
+  if (!top.has("geometry")) top.fail("geometry", "missing (e.g. geometry: {base: circle})");
+  parse_geometry(YamlBlock(top.get("geometry"), source, "geometry"), base_dir, s);
 
   YamlBlock mesh(top.get("mesh"), source, "mesh");
   if (mesh.has("h")) {
     s.h = mesh.number("h");
-    if (!(s.h > 0 && s.h <= 1)) mesh.fail("h", "must be in (0, 1]");
+    if (s.base == "polygon" ? !(s.h > 0) : !(s.h > 0 && s.h <= 1))
+      mesh.fail("h", s.base == "polygon" ? "must be > 0 (in the polygon's length unit)" : "must be in (0, 1]");
   }
   if (mesh.has("degree")) {
     s.degree = int(mesh.integer("degree"));

@@ -18,6 +18,10 @@ double Params::number_in(const std::string& key, double lo, double hi, bool lo_o
   return v;
 }
 
+std::string list_of(std::size_t n) {
+  return n ? fmt::format("a list of {} numbers", n) : std::string("a list of numbers");
+}
+
 double MapParams::number(const std::string& key) const {
   auto it = values_.find(key);
   if (it == values_.end()) fail(key, "missing (a number is required)");
@@ -30,9 +34,9 @@ double MapParams::number(const std::string& key) const {
 
 std::vector<double> MapParams::vector(const std::string& key, std::size_t n) const {
   auto it = values_.find(key);
-  if (it == values_.end()) fail(key, fmt::format("missing (a list of {} numbers is required)", n));
+  if (it == values_.end()) fail(key, "missing (" + list_of(n) + " is required)");
   auto* v = std::get_if<std::vector<double>>(&it->second);
-  if (!v || v->size() != n) throw InputError(origin_, key, fmt::format("must be a list of {} numbers", n));
+  if (!v || (n ? v->size() != n : v->empty())) throw InputError(origin_, key, "must be " + list_of(n));
   return *v;
 }
 

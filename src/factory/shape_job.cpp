@@ -103,14 +103,16 @@ class Channels {
       const std::string c = p.effects()[i]->channel();
       if (c.empty()) continue;
       auto it = std::find_if(channels_.begin(), channels_.end(), [&](const Channel& x) { return x.name == c; });
-      if (it == channels_.end()) it = channels_.insert(channels_.end(), Channel{c, {}, {}, {}});
+      if (it == channels_.end())
+        it = channels_.insert(channels_.end(), Channel{c, p.effects()[i]->channel_components(p.space().dim()), {}, {}, {}});
       it->effects.push_back(i);
     }
   }
-  void allocate(std::size_t node_values, std::size_t grid_values) {
+  /// `node_points`: load cases x nodes, `grid_points`: load cases x grid points.
+  void allocate(std::size_t node_points, std::size_t grid_points) {
     for (auto& c : channels_) {
-      if (rep_.point_cloud) c.nodes.assign(node_values, 0.0);
-      if (rep_.grid) c.grid.assign(grid_values, 0.0f);
+      if (rep_.point_cloud) c.nodes.assign(node_points * std::size_t(c.components), 0.0);
+      if (rep_.grid) c.grid.assign(grid_points * std::size_t(c.components), 0.0f);
     }
   }
   /// Load case L (group root).
@@ -118,22 +120,24 @@ class Channels {
             const std::vector<std::int8_t>& neumann, const std::vector<double>& grid, Moments& moments) {
     const std::size_t n_nodes = nodes.size() / std::size_t(d), n_grid = grid.size() / std::size_t(d);
     for (auto& c : channels_) {
+      const auto nc = std::size_t(c.components);
       if (rep_.point_cloud) {
-        double* v = c.nodes.data() + L * n_nodes * std::size_t(d);
+        double* v = c.nodes.data() + L * n_nodes * nc;
         add(p, c, alpha, d, nodes, &neumann, v);
-        moments.add(c.name, v, n_nodes * std::size_t(d), d);
+        moments.add(c.name, v, n_nodes * nc, c.components);
       }
       if (rep_.grid) {
-        std::vector<double> g(n_grid * std::size_t(d), 0.0);
+        std::vector<double> g(n_grid * nc, 0.0);
         add(p, c, alpha, d, grid, nullptr, g.data());
         std::copy(g.begin(), g.end(), c.grid.begin() + std::ptrdiff_t(L * g.size()));
-        moments.add("grid_" + c.name, g.data(), g.size(), d);
+        moments.add("grid_" + c.name, g.data(), g.size(), c.components);
       }
     }
   }
   void store(std::vector<io::Array>& arrays, std::uint64_t n_loads, std::uint64_t n_nodes,
-             const std::vector<std::uint64_t>& grid_shape, std::uint64_t d) {
+             const std::vector<std::uint64_t>& grid_shape) {
     for (auto& c : channels_) {
+      const auto d = std::uint64_t(c.components);
       if (rep_.point_cloud) {
         arrays.push_back(schema_array("loads/" + c.name, {n_loads, n_nodes, d}, std::move(c.nodes)));
       }
@@ -149,23 +153,27 @@ class Channels {
  private:
   struct Channel {
     std::string name;
+    int components;
     std::vector<std::size_t> effects;
     std::vector<double> nodes;
     std::vector<float> grid;
   };
-  /// Adds the channel's value at `points` into v; `neumann` (nodes): surface channels there only.
+  /// Adds the channel's value at `points` (d coordinates each) into v (c.components each);
+  /// `neumann` (nodes): surface channels there only. A load's channel is scaled like its load; a
+  /// material's (a modulus field) is not.
   static void add(const physics::Problem& p, const Channel& c, double alpha, int d, const std::vector<double>& points,
                   const std::vector<std::int8_t>* neumann, double* v) {
     const std::size_t n = points.size() / std::size_t(d);
     for (std::size_t i : c.effects) {
       const physics::Effect& e = *p.effects()[i];
       if (!e.active()) continue;
-      const double scale = e.scaled() ? alpha : 1.0;
+      const double scale = e.has_load() && e.scaled() ? alpha : 1.0;
+      const auto nc = std::size_t(c.components);
       for (std::size_t a = 0; a < n; ++a) {
         if (neumann && e.channel_on_boundary() && !(*neumann)[a]) continue;
         double t[3] = {0, 0, 0};
         e.channel_value(&points[a * std::size_t(d)], t);
-        for (int k = 0; k < d; ++k) v[a * std::size_t(d) + std::size_t(k)] += scale * t[k];
+        for (std::size_t k = 0; k < nc; ++k) v[a * nc + k] += scale * t[k];
       }
     }
   }
@@ -335,7 +343,7 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
   if (root) {
     displacement.assign(std::size_t(n_loads * n_nodes * d), 0.0);
     if (cfg.representations.grid) grid_u.assign(std::size_t(n_loads) * n_grid * std::size_t(d), 0.0f);
-    channels.allocate(displacement.size(), std::size_t(n_loads) * n_grid * std::size_t(d));
+    channels.allocate(std::size_t(n_loads * n_nodes), std::size_t(n_loads) * n_grid);
   }
   for (int l = 0; l < n_loads; ++l) {
     const LoadCase& lc = cases[std::size_t(l)];
@@ -433,7 +441,7 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
       s.push_back(du);
       arrays.push_back(schema_array("loads/grid_displacement", s, std::move(grid_u)));
     }
-    channels.store(arrays, nl_, U64(n_nodes), grid_shape, du);
+    channels.store(arrays, nl_, U64(n_nodes), grid_shape);
     drawn.store(arrays);
     moments.store(arrays);
     out.entry.load_reasons = std::move(reasons);

@@ -129,7 +129,11 @@ SceneOutcome solve_scene(MPI_Comm comm, const config::Scene& scene_in, const Sce
       mo.h = scene.h;
       mo.clamp_size = scene.h * scene.clamp_refinement;
       auto clamp = clamp_of(resolved, scene.dim);
-      core::on_root(comm, [&] { m = scene.dim == 2 ? mesh::mesh_disk(mo, clamp) : mesh::mesh_ball(mo, clamp); });
+      core::on_root(comm, [&] {
+        m = scene.base == "polygon" ? mesh::mesh_polygon(scene.polygon, scene.h)
+            : scene.dim == 2        ? mesh::mesh_disk(mo, clamp)
+                                    : mesh::mesh_ball(mo, clamp);
+      });
     }
   }
   std::unique_ptr<physics::Problem> problem;

@@ -291,6 +291,24 @@ MeshData mesh_box(int dim, double length, double h) {
   });
 }
 
+MeshData mesh_polygon(const std::vector<std::array<double, 2>>& points, double h) {
+  if (points.size() < 3 || !(h > 0)) throw std::invalid_argument("mesh_polygon: needs >= 3 points and h > 0");
+  return guarded("meshing a polygon", [&] {
+    ScopedModel model("polygon");
+    set_common_options(h);
+    std::vector<int> tags, lines;
+    for (const auto& p : points) tags.push_back(gmsh::model::geo::addPoint(p[0], p[1], 0, h));
+    for (std::size_t i = 0; i < tags.size(); ++i)
+      lines.push_back(gmsh::model::geo::addLine(tags[i], tags[(i + 1) % tags.size()]));
+    gmsh::model::geo::addPlaneSurface({gmsh::model::geo::addCurveLoop(lines)});
+    gmsh::model::geo::synchronize();
+    gmsh::model::mesh::generate(2);
+    MeshData m = extract(2);
+    if (m.n_cells() == 0) throw std::runtime_error("gmsh produced no triangles for the polygon");
+    return m;
+  });
+}
+
 MeshData read_mesh_file(const std::string& path) {
   namespace fs = std::filesystem;
   std::error_code ec;

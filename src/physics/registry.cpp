@@ -27,6 +27,12 @@ void register_builtin() {
     register_dirichlet_patch();
     register_gaussian_traction();
     register_body_force();
+    register_saint_venant_kirchhoff();
+    register_mooney_rivlin();
+    register_linear_elastic();
+    register_pressure();
+    register_uniform_traction();
+    register_dirichlet_region();
   });
 }
 

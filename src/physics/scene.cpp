@@ -59,9 +59,9 @@ double EffectParams::number(const std::string& key) const {
 std::vector<double> EffectParams::vector(const std::string& key, std::size_t n) const {
   used_.insert(key);
   auto it = values_.find(key);
-  if (it == values_.end()) fail(key, fmt::format("missing (a list of {} numbers is required)", n));
+  if (it == values_.end()) fail(key, "missing (" + core::list_of(n) + " is required)");
   auto* v = std::get_if<std::vector<double>>(&it->second);
-  if (!v || v->size() != n) fail(key, fmt::format("must be a list of {} numbers", n));
+  if (!v || (n ? v->size() != n : v->empty())) fail(key, "must be " + core::list_of(n));
   return *v;
 }
 

@@ -41,6 +41,31 @@ std::vector<PetscInt> closure_of_depth(DM dm, PetscInt p, PetscInt d0, PetscInt 
   return out;
 }
 
+/// The unit normal of boundary facet `fv` pointing out of its (only) cell, in the reference
+/// configuration: the geometric normal, flipped if it points towards the cell's centroid.
+std::array<double, 3> outward_normal(DM dm, PetscSection cs, const PetscScalar* xa, const FacetView& fv,
+                                     PetscInt v0, PetscInt v1, int dim) {
+  const auto &a = fv.x[0], &b = fv.x[1];
+  std::array<double, 3> n{b[1] - a[1], a[0] - b[0], 0.0};
+  if (dim == 3) {
+    const auto& c = fv.x[2];
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    n = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+  }
+  const double norm = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  const PetscInt* support;
+  HS_PETSC(DMPlexGetSupport(dm, fv.point, &support));
+  const auto verts = closure_of_depth(dm, support[0], v0, v1);
+  double towards_cell = 0;
+  for (PetscInt v : verts) {
+    const auto x = vertex_coords(cs, xa, v, dim);
+    for (int k = 0; k < dim; ++k) towards_cell += (x[k] - a[k]) * n[k];
+  }
+  const double s = (towards_cell > 0 ? -1.0 : 1.0) / norm;
+  for (double& c : n) c *= s;
+  return n;
+}
+
 }  // namespace
 
 std::array<double, 3> Space::node_coords(DM dm, PetscSection cs, const PetscScalar* xa, PetscInt p,
@@ -223,6 +248,7 @@ Space::Space(core::DMH dm, DM serial, PetscSF migration, const SpaceOptions& opt
       auto verts = closure_of_depth(dm_, f, v0, v1);
       fv.n_vertices = int(verts.size());
       for (int a = 0; a < fv.n_vertices; ++a) fv.x[a] = vertex_coords(cs, xa, verts[a], dim_);
+      fv.normal = outward_normal(dm_, cs, xa, fv, v0, v1, dim_);
       PetscInt n, *cl = nullptr;
       HS_PETSC(DMPlexGetTransitiveClosure(dm_, f, PETSC_TRUE, &n, &cl));
       fv.n_nodes = 0;

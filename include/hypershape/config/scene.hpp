@@ -3,6 +3,7 @@
 ///
 /// ```yaml
 /// geometry: {base: circle}            # circle (2D) | sphere (3D) | file (+ file: PATH.msh)
+///                                     # or {polygon: [[x, y], ...]} (2D, straight edges)
 /// mesh: {h: 0.05, degree: 1, clamp_refinement: 0.25}
 /// effects:                           # a list for an effect that appears several times:
 ///   neo_hookean: {E: 500, nu: 0.49}   #   gaussian_traction: [{...}, {...}]
@@ -15,6 +16,7 @@
 /// ```
 /// Every key is checked: unknown keys, wrong types and out-of-range values throw
 /// core::InputError naming the file and the key path.
+#include <array>
 #include <memory>
 #include <optional>
 #include <string>
@@ -31,7 +33,8 @@ namespace hypershape::config {
 struct Scene {
   std::string source;      ///< file name, or "<default scene>"
   std::string text;        ///< the YAML as read (stored with the results)
-  std::string base;        ///< circle | sphere | file
+  std::string base;        ///< circle | sphere | file | polygon
+  std::vector<std::array<double, 2>> polygon;  ///< base == polygon: its points in order
   std::string mesh_file;   ///< resolved path when base == file
   int dim = 2;             ///< 0 until known for base == file
   double h = 0.05;

@@ -15,7 +15,7 @@ class Params {
   virtual bool has(const std::string& key) const = 0;
   /// A finite number; throws InputError naming the file and key if missing or not a number.
   virtual double number(const std::string& key) const = 0;
-  /// A list of exactly `n` finite numbers.
+  /// A list of exactly `n` finite numbers (n = 0: of any length >= 1).
   virtual std::vector<double> vector(const std::string& key, std::size_t n) const = 0;
   virtual std::string text(const std::string& key) const = 0;
   /// Throws InputError naming the file and this block's `key`.
@@ -28,6 +28,9 @@ class Params {
   double number_in(const std::string& key, double lo, double hi, bool lo_open = false,
                    bool hi_open = false) const;
 };
+
+/// "a list of n numbers" (n = 0: "a list of numbers"), for messages.
+std::string list_of(std::size_t n);
 
 /// Params held in memory (tests, benchmarks, programmatic scenes). `fail` reports `origin`.
 class MapParams : public Params {

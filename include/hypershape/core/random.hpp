@@ -25,6 +25,7 @@ enum class Purpose : std::uint64_t {
   target = 4,      ///< target displacement magnitude of a load case
   split = 5,       ///< train/val/test assignment of shapes
   parameter = 6,   ///< a scene parameter drawn from a distribution (per shape or load case)
+  material = 7,    ///< a material's modulus field (its random Fourier modes)
   test = 99,       ///< tests and benchmarks
 };
 

@@ -1,6 +1,8 @@
 #pragma once
 /// Meshes built in-process with the gmsh C++ API. Only this module includes gmsh.h.
+#include <array>
 #include <optional>
+#include <vector>
 #include <string>
 
 #include "hypershape/mesh/mesh_data.hpp"
@@ -38,6 +40,12 @@ MeshData mesh_ball(const MeshOptions& opt, const std::optional<ClampRegion>& cla
 
 /// The box [0, L]^dim (unstructured simplices of size h), for verification problems.
 MeshData mesh_box(int dim, double length, double h);
+
+/// The inside of a simple polygon (points in order, either orientation, not repeated at the
+/// end) with straight edges; every point is a mesh vertex; element size h. Not collective.
+/// Throws std::invalid_argument for fewer than 3 points or h <= 0, std::runtime_error if gmsh
+/// fails (e.g. a self-intersecting polygon).
+MeshData mesh_polygon(const std::vector<std::array<double, 2>>& points, double h);
 
 /// Reads a gmsh .msh file (its highest-dimensional simplices). Throws core::InputError naming
 /// `path` if the file is missing, unreadable or holds no triangles/tetrahedra.

@@ -61,9 +61,12 @@ class Effect {
   /// The model-input field the effect brings ("traction", "body_force"), "" for none. A dataset
   /// stores each channel at the nodes and on the grid; effects of one channel are summed.
   virtual std::string channel() const { return ""; }
+  /// Components of the channel in a problem of dimension `dim` (a vector field: dim).
+  virtual int channel_components(int dim) const { return dim; }
   /// True for a surface field: stored at the Neumann boundary nodes only (zero elsewhere).
   virtual bool channel_on_boundary() const { return false; }
-  /// The field at x for load factor 1 (`dim` components). Valid after setup(). Not collective.
+  /// The field at x for load factor 1 (channel_components() values). Valid after setup(). Not
+  /// collective. A material's channel (a modulus field) is not scaled by the load factor.
   virtual void channel_value(const double* /*x*/, double* /*value*/) const {}
 
   /// Whether the load factor scales this effect's load (f_ext) or it is fixed (f_fixed).
@@ -94,6 +97,8 @@ std::vector<std::pair<std::string, std::string>> registered_effects();
 
 /// Selects boundary facets by the coordinates of their vertices (n_vertices x dim, row-major).
 using FacetPredicate = std::function<bool(const double* vertex_coords, int n_vertices, int dim)>;
+/// A scalar field of the reference position (e.g. a modulus factor m(x) > 0).
+using ScalarFunction = std::function<double(const double* x)>;
 /// Traction t(x) per unit reference area (first Piola), writes dim components.
 using VectorFunction = std::function<void(const double* x, double* value)>;
 

@@ -1,13 +1,22 @@
 #pragma once
 /// Hand-written, fixed-size element loops for any hyperelastic kernel `K<D>` with
-///   bool energy(F, W), bool stress(F, P), bool stress_tangent(F, P, A)
+///   bool energy(F, W), bool stress(F, P), bool stress_tangent(F, P, A),
+///   std::vector<double> constants(), static K<D> from_constants(const PetscScalar*)
 /// (see neo_hookean.hpp). Total Lagrangian: the reference geometry is fixed, so everything
 /// geometric comes precomputed from Space. A material file instantiates HyperelasticEffect with
-/// its kernel and adds PETSc pointwise functions for the generic path.
+/// its kernel; the PETSc pointwise functions of the generic path come from the same kernel.
+///
+/// A modulus field: W(x, F) = m(x) W(F) with a positive factor m(x) evaluated at every
+/// quadrature point once per mesh (setup). It multiplies the quadrature weight, so a material
+/// without a field assembles exactly the same numbers as before fields existed.
 #include <Eigen/Dense>
 #include <array>
+#include <functional>
+#include <stdexcept>
 #include <string>
+#include <vector>
 
+#include "hypershape/core/error.hpp"
 #include "hypershape/physics/effect.hpp"
 #include "hypershape/physics/neo_hookean.hpp"
 
@@ -30,6 +39,50 @@ inline void gather(const Space& s, PetscInt c, const PetscScalar* u, Eigen::Matr
     for (int i = 0; i < D; ++i) ue(a, i) = u[idx[a * D + i]];
 }
 
+template <int D>
+Tensor<D> deformation_gradient(const PetscScalar u_x[]) {
+  Tensor<D> F;
+  for (int i = 0; i < D; ++i)
+    for (int j = 0; j < D; ++j) F(i, j) = (i == j ? 1.0 : 0.0) + u_x[i * D + j];
+  return F;
+}
+
+/// PETSc pointwise residual f1 = P(F) of kernel K (constants: K's constants()).
+template <template <int> class K>
+void f1_pointwise(PetscInt dim, PetscInt, PetscInt, const PetscInt[], const PetscInt[],
+                  const PetscScalar[], const PetscScalar[], const PetscScalar u_x[],
+                  const PetscInt[], const PetscInt[], const PetscScalar[], const PetscScalar[],
+                  const PetscScalar[], PetscReal, const PetscReal[], PetscInt,
+                  const PetscScalar c[], PetscScalar f1[]) {
+  auto run = [&]<int D>() {
+    Tensor<D> P = Tensor<D>::Zero();
+    K<D>::from_constants(c).stress(deformation_gradient<D>(u_x), P);
+    for (int i = 0; i < D; ++i)
+      for (int j = 0; j < D; ++j) f1[i * D + j] = P(i, j);
+  };
+  if (dim == 2) run.template operator()<2>(); else run.template operator()<3>();
+}
+
+/// PETSc pointwise tangent g3 = dP/dF of kernel K.
+template <template <int> class K>
+void g3_pointwise(PetscInt dim, PetscInt, PetscInt, const PetscInt[], const PetscInt[],
+                  const PetscScalar[], const PetscScalar[], const PetscScalar u_x[],
+                  const PetscInt[], const PetscInt[], const PetscScalar[], const PetscScalar[],
+                  const PetscScalar[], PetscReal, PetscReal, const PetscReal[], PetscInt,
+                  const PetscScalar c[], PetscScalar g3[]) {
+  auto run = [&]<int D>() {
+    Tensor<D> P;
+    Tangent<D> A = Tangent<D>::Zero();
+    K<D>::from_constants(c).stress_tangent(deformation_gradient<D>(u_x), P, A);
+    // PETSc layout: g3[((i * D + k) * D + J) * D + L] = dP_iJ / dF_kL.
+    for (int i = 0; i < D; ++i)
+      for (int k = 0; k < D; ++k)
+        for (int J = 0; J < D; ++J)
+          for (int L = 0; L < D; ++L) g3[((i * D + k) * D + J) * D + L] = A(i * D + J, k * D + L);
+  };
+  if (dim == 2) run.template operator()<2>(); else run.template operator()<3>();
+}
+
 /// Loops over the local cells with kernel `K<D>` for the (D, NB) given at run time.
 template <template <int> class K, class Op>
 bool dispatch(const Space& s, Op&& op) {
@@ -44,13 +97,46 @@ bool dispatch(const Space& s, Op&& op) {
 
 }  // namespace detail
 
-/// A stored-energy effect from a pointwise kernel family K<2>, K<3> built from parameters P.
+/// A stored-energy effect from a pointwise kernel family K<2>, K<3>, optionally times a
+/// modulus field m(x) (`field`, empty for none).
 template <template <int> class K>
 class HyperelasticEffect : public Effect {
  public:
-  HyperelasticEffect(std::string name, K<2> k2, K<3> k3) : name_(std::move(name)), k2_(k2), k3_(k3) {}
+  HyperelasticEffect(std::string name, K<2> k2, K<3> k3, ScalarFunction field = {})
+      : name_(std::move(name)), k2_(k2), k3_(k3), field_(std::move(field)) {}
   std::string name() const override { return name_; }
   bool has_energy() const override { return true; }
+
+  /// Evaluates the modulus field at the quadrature points of the local cells. Not collective.
+  void setup(const Space& s) override {
+    factor_.clear();
+    if (!field_) return;
+    factor_.reserve(std::size_t(s.cell_end() - s.cell_begin()) * s.n_qp());
+    for (PetscInt c = s.cell_begin(); c < s.cell_end(); ++c)
+      for (int q = 0; q < s.n_qp(); ++q) {
+        double x[3] = {0, 0, 0};
+        s.map_point(c, q, x);
+        factor_.push_back(field_(x));
+      }
+  }
+  /// The modulus field's channel: m(x) in the first component (a scalar field).
+  std::string channel() const override { return field_ ? "modulus" : ""; }
+  int channel_components(int) const override { return 1; }
+  void channel_value(const double* x, double* value) const override {
+    value[0] = field_ ? field_(x) : 1.0;
+  }
+  bool has_field() const { return bool(field_); }
+
+  void set_pointwise(PetscDS ds) const override {
+    if (field_)
+      throw std::logic_error(name_ + ": PETSc's pointwise path has no modulus field (cross-checks "
+                                     "are for homogeneous materials)");
+    const std::vector<double> k = k2_.constants();
+    std::vector<PetscScalar> c(k.begin(), k.end());
+    HS_PETSC(PetscDSSetConstants(ds, PetscInt(c.size()), c.data()));
+    HS_PETSC(PetscDSSetResidual(ds, 0, nullptr, detail::f1_pointwise<K>));
+    HS_PETSC(PetscDSSetJacobian(ds, 0, 0, nullptr, nullptr, nullptr, detail::g3_pointwise<K>));
+  }
 
   bool add_energy(const Space& s, const PetscScalar* u, double& energy) const override {
     return detail::dispatch<K>(s, [&]<int D, int NB>() {
@@ -64,7 +150,7 @@ class HyperelasticEffect : public Effect {
           const Tensor<D> F = Tensor<D>::Identity() + ue.transpose() * G;
           double W;
           if (!k.energy(F, W)) return false;
-          energy += s.qweight(q) * dj * W;
+          energy += weight(s, c, q, dj) * W;
         }
       }
       return true;
@@ -84,7 +170,7 @@ class HyperelasticEffect : public Effect {
           detail::physical_gradients<D, NB>(s, c, q, G);
           const Tensor<D> F = Tensor<D>::Identity() + ue.transpose() * G;
           if (!k.stress(F, P)) return false;
-          re.noalias() += (s.qweight(q) * dj) * (G * P.transpose());  // r_ai = sum_J P_iJ G_aJ
+          re.noalias() += weight(s, c, q, dj) * (G * P.transpose());  // r_ai = sum_J P_iJ G_aJ
         }
         const PetscInt* idx = s.local_dofs(c);
         for (int a = 0; a < NB; ++a)
@@ -112,7 +198,7 @@ class HyperelasticEffect : public Effect {
           detail::physical_gradients<D, NB>(s, c, q, G);
           const Tensor<D> F = Tensor<D>::Identity() + ue.transpose() * G;
           if (!k.stress_tangent(F, P, A)) return false;
-          const double w = s.qweight(q) * dj;
+          const double w = weight(s, c, q, dj);
           for (int b = 0; b < NB; ++b)
             for (int kk = 0; kk < D; ++kk)
               AG.col(b * D + kk).noalias() = A.template middleCols<D>(kk * D) * G.row(b).transpose();
@@ -131,9 +217,16 @@ class HyperelasticEffect : public Effect {
   const K<D>& kernel() const {
     if constexpr (D == 2) return k2_; else return k3_;
   }
+  /// Quadrature weight times det J, times the modulus field there if there is one.
+  double weight(const Space& s, PetscInt c, int q, double dj) const {
+    const double w = s.qweight(q) * dj;
+    return factor_.empty() ? w : w * factor_[std::size_t(c - s.cell_begin()) * s.n_qp() + q];
+  }
   std::string name_;
   K<2> k2_;
   K<3> k3_;
+  ScalarFunction field_;
+  std::vector<double> factor_;  ///< m(x) per local cell and quadrature point
 };
 
 }  // namespace hypershape::physics

@@ -8,6 +8,7 @@
 /// fixed-size: every function returns false (and leaves outputs untouched) if J <= 0.
 #include <Eigen/Dense>
 #include <cmath>
+#include <vector>
 
 namespace hypershape::physics {
 
@@ -28,6 +29,10 @@ struct Lame {
 template <int D>
 struct NeoHookean {
   double mu = 0, lambda = 0;
+
+  /// The PETSc pointwise constants (mu, lambda) and back.
+  std::vector<double> constants() const { return {mu, lambda}; }
+  static NeoHookean from_constants(const double* c) { return {c[0], c[1]}; }
 
   bool energy(const Tensor<D>& F, double& W) const {
     const double J = F.determinant();

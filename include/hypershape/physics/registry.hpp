@@ -1,6 +1,7 @@
 #pragma once
 /// Built-in effects: one registration function per effect file, called once by registry.cpp.
 #include "hypershape/physics/effect.hpp"
+#include "hypershape/physics/region.hpp"
 
 namespace hypershape::physics {
 
@@ -8,9 +9,24 @@ void register_neo_hookean();
 void register_dirichlet_patch();
 void register_gaussian_traction();
 void register_body_force();
+void register_saint_venant_kirchhoff();
+void register_mooney_rivlin();
+void register_linear_elastic();
+void register_pressure();
+void register_uniform_traction();
+void register_dirichlet_region();
 
 /// Direct constructors of the built-in effects (tests, benchmarks, programmatic scenes).
-EffectPtr make_neo_hookean(double E, double nu);
+/// Materials; `field` (optional) is a modulus factor m(x) > 0: W(x, F) = m(x) W(F).
+EffectPtr make_neo_hookean(double E, double nu, ScalarFunction field = {});
+EffectPtr make_saint_venant_kirchhoff(double E, double nu, ScalarFunction field = {});
+/// C1, C2 >= 0 with C1 + C2 > 0, kappa > 0 (see mooney_rivlin.hpp).
+EffectPtr make_mooney_rivlin(double C1, double C2, double kappa, ScalarFunction field = {});
+EffectPtr make_linear_elastic(double E, double nu, ScalarFunction field = {});
+/// Dead pressure p on the region's Neumann facets: t = -p N (outward reference normal N).
+EffectPtr make_pressure(double p, const Region& region, int dim);
+/// Uniform dead traction t (dim components) on the region's Neumann facets.
+EffectPtr make_uniform_traction(const std::vector<double>& t, const Region& region);
 EffectPtr make_dirichlet_patch(const std::vector<double>& center, double radius);
 /// t(x) = g phi(x - p_N) / I_N, phi(y) = exp(-|y|^2 / (2 gamma^2)), I_N = int_{Gamma_N} phi;
 /// `direction` is normalised. The load factor (alpha) scales it.

@@ -31,6 +31,7 @@ struct FacetView {
   PetscInt point;
   int n_vertices;                      ///< dim
   std::array<std::array<double, 3>, 3> x;  ///< vertex coordinates (dim used)
+  std::array<double, 3> normal;        ///< outward unit normal (reference configuration)
   int n_nodes;                         ///< dofs-carrying closure points
   std::array<PetscInt, 6> offset;      ///< local-vector offset of each node's first component
   std::array<std::array<int, 2>, 6> ends;  ///< node at facet vertex a (a, a) or edge mid (a, b)

@@ -8,6 +8,7 @@
 #include "hypershape/core/error.hpp"
 #include "hypershape/physics/gaussian_traction.hpp"
 #include "hypershape/physics/registry.hpp"
+#include "hypershape/physics/surface_load.hpp"
 
 namespace hypershape::physics {
 
@@ -35,35 +36,30 @@ void for_each_facet_point(const Space& s, const FacetPredicate& select, Fn&& fn)
   }
 }
 
-class SurfaceTraction : public Effect {
- public:
-  SurfaceTraction(std::string name, VectorFunction t, FacetPredicate select)
-      : name_(std::move(name)), traction_(std::move(t)), select_(std::move(select)) {}
-  std::string name() const override { return name_; }
-  bool has_load() const override { return true; }
-  void add_load(const Space& s, PetscScalar* f) const override {
-    const int dim = s.dim();
-    for_each_facet_point(s, select_, [&](const FacetView& fv, const double* bary, const double* x,
-                                         double w) {
-      double t[3] = {0, 0, 0};
-      traction_(x, t);
-      for (int n = 0; n < fv.n_nodes; ++n) {
-        const double wn = w * s.facet_basis(fv.ends[n], bary);
-        for (int i = 0; i < dim; ++i) f[fv.offset[n] + i] += wn * t[i];
-      }
-    });
-  }
-
- protected:
-  std::string name_;
-  VectorFunction traction_;
-  FacetPredicate select_;
-};
+/// Adds int t . N_a dS to f for the traction `traction(facet, x, t)` on the selected facets.
+template <class Traction>
+void add_facet_load(const Space& s, const FacetPredicate& select, Traction&& traction, PetscScalar* f) {
+  const int dim = s.dim();
+  for_each_facet_point(s, select, [&](const FacetView& fv, const double* bary, const double* x, double w) {
+    double t[3] = {0, 0, 0};
+    traction(fv, x, t);
+    for (int n = 0; n < fv.n_nodes; ++n) {
+      const double wn = w * s.facet_basis(fv.ends[n], bary);
+      for (int i = 0; i < dim; ++i) f[fv.offset[n] + i] += wn * t[i];
+    }
+  });
+}
 
 }  // namespace
 
+void SurfaceLoad::add_load(const Space& s, PetscScalar* f) const {
+  add_facet_load(s, select_, [&](const FacetView& fv, const double* x, double* t) { load_(x, fv.normal.data(), t); }, f);
+}
+
 EffectPtr make_surface_traction(VectorFunction traction, FacetPredicate select) {
-  return std::make_unique<SurfaceTraction>("surface_traction", std::move(traction), std::move(select));
+  return std::make_unique<SurfaceLoad>(
+      "surface_traction", [t = std::move(traction)](const double* x, const double*, double* v) { t(x, v); },
+      std::move(select));
 }
 
 GaussianTraction::GaussianTraction(std::vector<double> center, std::vector<double> direction,
@@ -110,15 +106,7 @@ void GaussianTraction::value(const double* x, double* t) const {
 }
 
 void GaussianTraction::add_load(const Space& s, PetscScalar* f) const {
-  const int dim = s.dim();
-  for_each_facet_point(s, {}, [&](const FacetView& fv, const double* bary, const double* x, double w) {
-    double t[3] = {0, 0, 0};
-    value(x, t);
-    for (int n = 0; n < fv.n_nodes; ++n) {
-      const double wn = w * s.facet_basis(fv.ends[n], bary);
-      for (int i = 0; i < dim; ++i) f[fv.offset[n] + i] += wn * t[i];
-    }
-  });
+  add_facet_load(s, {}, [&](const FacetView&, const double* x, double* t) { value(x, t); }, f);
 }
 
 EffectPtr make_gaussian_traction(const std::vector<double>& center,

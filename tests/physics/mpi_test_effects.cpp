@@ -1,0 +1,76 @@
+/// The catalogue's effects give the same solution on any number of ranks: each scene on the
+/// disk solved on PETSC_COMM_WORLD (METIS-distributed) against rank 0 alone (PETSC_COMM_SELF).
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <functional>
+
+#include "hypershape/physics/material_params.hpp"
+#include "hypershape/solver/nonlinear.hpp"
+#include "support/helpers.hpp"
+
+using namespace hypershape;
+
+namespace {
+
+using Effects = std::function<std::vector<physics::EffectPtr>()>;
+
+double broadcast(double v) {
+  MPI_Bcast(&v, 1, MPI_DOUBLE, 0, PETSC_COMM_WORLD);
+  return v;
+}
+
+/// The clamped disk with the given material and loads, solved at load factor `alpha`.
+std::vector<double> solve(MPI_Comm comm, const Effects& effects, double alpha, bool& converged) {
+  mesh::MeshData m;
+  if (core::rank(comm) == 0) m = hstest::disk_mesh(0.1);
+  physics::Problem p(comm, m, effects(), hstest::degree(1));
+  solver::NonlinearSolver ns(p);
+  converged = ns.solve(alpha).converged;
+  return p.gather(ns.solution()).values;
+}
+
+std::vector<physics::EffectPtr> scene(physics::EffectPtr material, physics::EffectPtr load) {
+  std::vector<physics::EffectPtr> e;
+  e.push_back(std::move(material));
+  e.push_back(physics::make_dirichlet_patch({1.0, 0.0}, 0.5));
+  e.push_back(std::move(load));
+  return e;
+}
+
+physics::EffectPtr traction() { return physics::make_gaussian_traction({-1.0, 0.0}, {0.0, 1.0}, 0.2); }
+
+}  // namespace
+
+TEST_CASE("Catalogue effects have the same solution on any number of ranks", "[mpi][effects]") {
+  const physics::ScalarFunction field = [f = physics::LogNormalField(2, 0.4, 0.3, 5)](const double* x) { return f(x); };
+  const std::pair<const char*, Effects> cases[] = {
+      {"saint_venant_kirchhoff", [] { return scene(physics::make_saint_venant_kirchhoff(500, 0.4), traction()); }},
+      {"mooney_rivlin", [] { return scene(physics::make_mooney_rivlin(60, 20, 800), traction()); }},
+      {"linear_elastic", [] { return scene(physics::make_linear_elastic(500, 0.4), traction()); }},
+      {"neo_hookean with a modulus field", [field] { return scene(physics::make_neo_hookean(500, 0.4, field), traction()); }},
+      {"pressure on a ball region",
+       [] { return scene(physics::make_neo_hookean(500, 0.4), physics::make_pressure(1.0, physics::Region::ball({-1, 0}, 0.8), 2)); }},
+      {"uniform traction on a box region",
+       [] {
+         return scene(physics::make_neo_hookean(500, 0.4),
+                      physics::make_uniform_traction({0.0, -2.0}, physics::Region::box({-1, 0}, {0, 1})));
+       }},
+  };
+  for (const auto& [name, effects] : cases) {
+    DYNAMIC_SECTION(name) {
+      bool ref_ok = false, ok = false;
+      std::vector<double> ref;
+      if (core::rank(PETSC_COMM_WORLD) == 0) ref = solve(PETSC_COMM_SELF, effects, 10.0, ref_ok);
+      const std::vector<double> u = solve(PETSC_COMM_WORLD, effects, 10.0, ok);
+      double d = 0, scale = 0;
+      for (std::size_t i = 0; i < ref.size() && i < u.size(); ++i)
+        d = std::max(d, std::abs(u[i] - ref[i])), scale = std::max(scale, std::abs(ref[i]));
+      const double rel = broadcast(core::rank(PETSC_COMM_WORLD) == 0 && u.size() == ref.size() ? d / scale : 1.0);
+      INFO("ranks " << core::size(PETSC_COMM_WORLD) << ": max|u| " << broadcast(scale) << ", relative difference " << rel);
+      CHECK(broadcast(ref_ok) == 1.0);
+      CHECK(ok);
+      CHECK(broadcast(scale) > 1e-3);
+      CHECK(rel < 1e-9);
+    }
+  }
+}

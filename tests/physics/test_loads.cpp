@@ -1,0 +1,236 @@
+/// Pressure and uniform traction on regions: the resultant of a pressure on a quarter circle,
+/// the thick-walled cylinder (plane strain quarter annulus) under internal pressure against
+/// Lame's closed form (linear elasticity, and Neo-Hookean at a small load), a uniform traction's
+/// total force, and the effects' keys.
+#include <catch2/catch.hpp>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+
+#include "hypershape/core/error.hpp"
+#include "hypershape/physics/neo_hookean.hpp"
+#include "support/helpers.hpp"
+
+using namespace hypershape;
+
+namespace {
+
+constexpr double a_in = 1.0, b_out = 2.0;
+
+/// The quarter annulus a <= r <= b, x, y >= 0, its arcs as polygons of n segments each.
+mesh::MeshData quarter_annulus(double h, int n = 96) {
+  std::vector<std::array<double, 2>> p;
+  const double pi = std::numbers::pi;
+  for (int i = 0; i <= n; ++i) p.push_back({b_out * std::cos(pi / 2 * i / n), b_out * std::sin(pi / 2 * i / n)});
+  for (int i = n; i >= 0; --i) p.push_back({a_in * std::cos(pi / 2 * i / n), a_in * std::sin(pi / 2 * i / n)});
+  return mesh::mesh_polygon(p, h);
+}
+
+/// Rollers on the symmetry planes, pressure p on the inner arc (a ball region of radius a).
+std::unique_ptr<physics::Problem> cylinder(physics::EffectPtr material, double p, int degree, double h) {
+  std::vector<physics::EffectPtr> e;
+  e.push_back(std::move(material));
+  e.push_back(physics::make_dirichlet("sym_x", hstest::on_plane(0, 0.0), {0}));
+  e.push_back(physics::make_dirichlet("sym_y", hstest::on_plane(1, 0.0), {1}));
+  e.push_back(physics::make_pressure(p, physics::Region::ball({0.0, 0.0}, a_in), 2));
+  return std::make_unique<physics::Problem>(PETSC_COMM_WORLD, quarter_annulus(h), std::move(e), hstest::degree(degree));
+}
+
+/// Lame, plane strain: u_r = A r + B / r, A = p a^2 (1+nu)(1-2nu) / (E (b^2-a^2)),
+/// B = p a^2 b^2 (1+nu) / (E (b^2-a^2)).
+double lame_ur(double r, double p, double E, double nu) {
+  const double d = E * (b_out * b_out - a_in * a_in);
+  return p * a_in * a_in * (1 + nu) * ((1 - 2 * nu) * r + b_out * b_out / r) / d;
+}
+
+/// max over nodes of |u_r - lame| / max lame, and of |u_theta| / max lame (rank 0's view,
+/// broadcast).
+std::pair<double, double> lame_error(const physics::Problem& pb, Vec u, double p, double E, double nu) {
+  const physics::NodalField f = pb.gather(u);
+  const auto& X = pb.space().canonical_coords();
+  double err[2] = {0, 0};
+  const double scale = lame_ur(a_in, p, E, nu);
+  for (std::size_t n = 0; 2 * n < f.values.size(); ++n) {
+    const double x = X[2 * n], y = X[2 * n + 1], r = std::hypot(x, y);
+    const double ur = (f.values[2 * n] * x + f.values[2 * n + 1] * y) / r;
+    const double ut = (-f.values[2 * n] * y + f.values[2 * n + 1] * x) / r;
+    err[0] = std::max(err[0], std::abs(ur - lame_ur(r, p, E, nu)) / scale);
+    err[1] = std::max(err[1], std::abs(ut) / scale);
+  }
+  MPI_Bcast(err, 2, MPI_DOUBLE, 0, PETSC_COMM_WORLD);
+  return {err[0], err[1]};
+}
+
+}  // namespace
+
+TEST_CASE("A pressure on a quarter circle has the resultant p a (1, 1) and pushes outwards", "[loads]") {
+  const double p = 3.0;
+  auto pb = cylinder(physics::make_linear_elastic(1000, 0.3), p, 1, 0.2);
+  core::VecH u = pb->create_vector();
+  HS_PETSC(VecZeroEntries(u));
+  const physics::Resultants r = pb->resultants(u, 1.0);
+  // The inner arc's outward normal points to the axis: t = -p N = p e_r.
+  INFO("applied force " << r.applied_force[0] << ", " << r.applied_force[1]);
+  CHECK(r.applied_force[0] == Approx(p * a_in).epsilon(1e-12));  // chords sum exactly
+  CHECK(r.applied_force[1] == Approx(p * a_in).epsilon(1e-12));
+}
+
+namespace {
+
+/// Solves the cylinder at pressure p and returns Lame's errors (see lame_error).
+std::pair<double, double> cylinder_error(physics::EffectPtr material, double p, double E, double nu) {
+  auto pb = cylinder(std::move(material), p, 2, 0.1);
+  solver::SolverOptions so;
+  so.rtol = 1e-12;
+  solver::NonlinearSolver ns(*pb, so);
+  REQUIRE(ns.solve(1.0).converged);
+  return lame_error(*pb, ns.solution(), p, E, nu);
+}
+
+/// Neo-Hookean principal nominal stress P_i at principal stretches (l_i, l_other), plane strain.
+double nh_principal(double li, double lo, double mu, double lambda) {
+  return mu * (li - 1 / li) + lambda * std::log(li * lo) / li;
+}
+
+/// The radial BVP of the Neo-Hookean cylinder under a dead internal pressure p: r(R) on [a, b]
+/// with l_r = r', l_t = r / R, d P_r / dR = (P_t - P_r) / R, P_r(a) = -p, P_r(b) = 0. Shooting
+/// on r(a) (secant) with RK4 in R (n steps); returns u_r = r - R at n + 1 equispaced R.
+std::vector<double> radial_bvp(double p, double mu, double lambda, int n) {
+  auto stretch_r = [&](double P, double lt) {  // l_r with P_r(l_r, l_t) = P, by Newton
+    double l = 1.0;
+    for (int it = 0; it < 50; ++it) {
+      const double g = nh_principal(l, lt, mu, lambda) - P;
+      const double dg = mu * (1 + 1 / (l * l)) + lambda * (1 - std::log(l * lt)) / (l * l);
+      l -= g / dg;
+      if (std::abs(g) < 1e-13 * (mu + lambda)) break;
+    }
+    return l;
+  };
+  auto rhs = [&](double R, const std::array<double, 2>& y) {  // y = (r, P_r)
+    const double lt = y[0] / R, lr = stretch_r(y[1], lt);
+    return std::array<double, 2>{lr, (nh_principal(lt, lr, mu, lambda) - y[1]) / R};
+  };
+  auto shoot = [&](double ra, std::vector<double>* u) {
+    std::array<double, 2> y{ra, -p};
+    const double dR = (b_out - a_in) / n;
+    for (int i = 0; i < n; ++i) {
+      const double R = a_in + i * dR;
+      if (u) u->push_back(y[0] - R);
+      auto add = [&](const std::array<double, 2>& k, double f) { return std::array<double, 2>{y[0] + f * k[0], y[1] + f * k[1]}; };
+      const auto k1 = rhs(R, y), k2 = rhs(R + dR / 2, add(k1, dR / 2)), k3 = rhs(R + dR / 2, add(k2, dR / 2)),
+                 k4 = rhs(R + dR, add(k3, dR));
+      for (int k = 0; k < 2; ++k) y[k] += dR / 6 * (k1[k] + 2 * k2[k] + 2 * k3[k] + k4[k]);
+    }
+    if (u) u->push_back(y[0] - b_out);
+    return y[1];  // P_r(b): zero at the solution
+  };
+  double r0 = a_in * 1.05, r1 = a_in * 1.1, f0 = shoot(r0, nullptr), f1 = shoot(r1, nullptr);
+  for (int it = 0; it < 60 && std::abs(f1) > 1e-12 * p; ++it) {
+    const double r2 = r1 - f1 * (r1 - r0) / (f1 - f0);
+    r0 = r1, f0 = f1, r1 = r2, f1 = shoot(r1, nullptr);
+  }
+  std::vector<double> u;
+  shoot(r1, &u);
+  return u;
+}
+
+}  // namespace
+
+TEST_CASE("Thick-walled cylinder at a finite pressure: the radial boundary-value problem", "[loads]") {
+  // Neo-Hookean, dead pressure p = 40 on the inner arc: u_r(a) / a ~ 0.09, far from linear.
+  const double E = 1000, nu = 0.3, p = 40.0;
+  const physics::Lame l = physics::Lame::from_young_poisson(E, nu);
+  const int n = 4000;
+  const std::vector<double> bvp = radial_bvp(p, l.mu, l.lambda, n);
+  auto pb = cylinder(physics::make_neo_hookean(E, nu), p, 2, 0.1);
+  solver::SolverOptions so;
+  so.rtol = 1e-12;
+  solver::NonlinearSolver ns(*pb, so);
+  REQUIRE(ns.solve(1.0).converged);
+  const physics::NodalField f = pb->gather(ns.solution());
+  const auto& X = pb->space().canonical_coords();
+  double err = 0, lame = 0;
+  for (std::size_t k = 0; 2 * k < f.values.size(); ++k) {
+    const double x = X[2 * k], y = X[2 * k + 1], R = std::hypot(x, y);
+    const double ur = (f.values[2 * k] * x + f.values[2 * k + 1] * y) / R;
+    const double s = std::clamp((R - a_in) / (b_out - a_in) * n, 0.0, double(n) - 1e-9);
+    const auto i = std::size_t(s);
+    const double exact = bvp[i] + (s - double(i)) * (bvp[i + 1] - bvp[i]);
+    err = std::max(err, std::abs(ur - exact) / bvp[0]);
+    lame = std::max(lame, std::abs(exact - lame_ur(R, p, E, nu)) / bvp[0]);
+  }
+  MPI_Bcast(&err, 1, MPI_DOUBLE, 0, PETSC_COMM_WORLD);
+  MPI_Bcast(&lame, 1, MPI_DOUBLE, 0, PETSC_COMM_WORLD);
+  INFO("u_r(a) = " << bvp[0] << ": max |u_r - BVP| / u_r(a) = " << err << "; the BVP differs from Lame by " << lame);
+  CHECK(lame > 0.02);  // a finite load: linear elasticity is far off
+  CHECK(err < 1e-3);
+}
+
+TEST_CASE("Thick-walled cylinder under internal pressure: Lame's solution", "[loads]") {
+  const double E = 1000, nu = 0.3;
+  // Linear elasticity: the discretisation and the polygonal arcs only (P2, 96 chords per arc).
+  const auto [er, et] = cylinder_error(physics::make_linear_elastic(E, nu), 10.0, E, nu);
+  INFO("linear: max |u_r - Lame| / u_r(a) = " << er << ", max |u_theta| / u_r(a) = " << et);
+  CHECK(er < 5e-4);
+  CHECK(et < 1e-3);
+  // Neo-Hookean at a small load (u_r(a) / a ~ 1e-3): the nonlinear part is ~1e-3 of the response.
+  const auto [nr, nt] = cylinder_error(physics::make_neo_hookean(E, nu), 0.5, E, nu);
+  INFO("Neo-Hookean: max |u_r - Lame| / u_r(a) = " << nr << ", max |u_theta| / u_r(a) = " << nt);
+  CHECK(nr < 1e-3);
+  CHECK(nt < 1e-3);
+}
+
+TEST_CASE("A uniform traction on a box region has the total force t times the edge length", "[loads]") {
+  std::vector<physics::EffectPtr> e;
+  e.push_back(physics::make_linear_elastic(1000, 0.3));
+  e.push_back(physics::make_dirichlet("clamp", hstest::on_plane(0, 0.0)));
+  // The right edge x = 1, but only 0.25 <= y <= 0.75 of it: a polygon with vertices there.
+  e.push_back(physics::make_uniform_traction({0.5, -2.0}, physics::Region::box({1.0, 0.25}, {1.0, 0.75})));
+  const mesh::MeshData m = mesh::mesh_polygon({{0, 0}, {1, 0}, {1, 0.25}, {1, 0.75}, {1, 1}, {0, 1}}, 0.1);
+  physics::Problem pb(PETSC_COMM_WORLD, m, std::move(e), hstest::degree(1));
+  core::VecH u = pb.create_vector();
+  HS_PETSC(VecZeroEntries(u));
+  const physics::Resultants r = pb.resultants(u, 1.0);
+  CHECK(r.applied_force[0] == Approx(0.25).epsilon(1e-12));
+  CHECK(r.applied_force[1] == Approx(-1.0).epsilon(1e-12));
+}
+
+TEST_CASE("In 3D a pressure on a face pushes along its inward normal", "[loads]") {
+  std::vector<physics::EffectPtr> e;
+  e.push_back(physics::make_linear_elastic(1000, 0.3));
+  e.push_back(physics::make_dirichlet("clamp", hstest::on_plane(0, 0.0)));
+  e.push_back(physics::make_pressure(2.0, physics::Region::box({1, 0, 0}, {1, 1, 1}), 3));
+  e.push_back(physics::make_pressure(0.5, physics::Region::box({0, 0, 1}, {1, 1, 1}), 3));
+  physics::Problem pb(PETSC_COMM_WORLD, mesh::mesh_box(3, 1.0, 0.4), std::move(e), hstest::degree(1));
+  core::VecH u = pb.create_vector();
+  HS_PETSC(VecZeroEntries(u));
+  const physics::Resultants r = pb.resultants(u, 1.0);
+  CHECK(r.applied_force[0] == Approx(-2.0).epsilon(1e-12));
+  CHECK(std::abs(r.applied_force[1]) < 1e-12);
+  CHECK(r.applied_force[2] == Approx(-0.5).epsilon(1e-12));
+}
+
+TEST_CASE("Loads and regions reject bad keys naming them", "[loads][input]") {
+  auto message = [](const char* effect, core::MapParams p) {
+    try {
+      physics::make_effect(effect, p, 2);
+    } catch (const core::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  CHECK_THAT(message("pressure", core::MapParams({{"value", 1.0}, {"box", std::vector<double>{0, 0, 1}}})),
+             Catch::Contains("box"));
+  CHECK_THAT(message("pressure", core::MapParams({{"value", 1.0}, {"box", std::vector<double>{1, 0, 0, 1}}})),
+             Catch::Contains("lower <= upper"));
+  CHECK_THAT(message("pressure", core::MapParams({{"box", std::vector<double>{0, 0, 1, 1}}})), Catch::Contains("value"));
+  CHECK_THAT(message("uniform_traction", core::MapParams({{"value", std::vector<double>{1.0}}})), Catch::Contains("value"));
+  CHECK_THAT(message("dirichlet", core::MapParams({{"components", std::vector<double>{0}}})), Catch::Contains("box"));
+  CHECK_THAT(message("dirichlet", core::MapParams({{"box", std::vector<double>{0, 0, 0, 1}},
+                                                   {"components", std::vector<double>{2}}})),
+             Catch::Contains("components"));
+  CHECK_THAT(message("pressure", core::MapParams({{"value", 1.0}, {"center", std::vector<double>{0, 0}},
+                                                  {"box", std::vector<double>{0, 0, 1, 1}}, {"radius", 1.0}})),
+             Catch::Contains("not both"));
+}
