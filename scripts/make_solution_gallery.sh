@@ -14,14 +14,17 @@
 #
 # Environment:
 #   HYPERSHAPE_BIN  the CLI (default build/hypershape)
-#   PRESETS         preset names (default: all eight)
+#   PRESETS         preset names (default: all eight; PRESETS= for none)
+#   CONFIGS         example dataset configs drawn as they are (default: configs/examples/*.yaml;
+#                   CONFIGS= for none)
 #   DATA_DIR        where the mini datasets go (default results/gallery; rewritten)
 #   OUT_DIR         figures (default docs/figures)
 set -euo pipefail
 
 cd "$(dirname "$0")/.."
 : "${HYPERSHAPE_BIN:=build/hypershape}" "${DATA_DIR:=results/gallery}" "${OUT_DIR:=docs/figures}"
-: "${PRESETS:=random2d easy_random2d ood_random2d one_random2d random3d aug_liver liver one_liver}"
+: "${PRESETS=random2d easy_random2d ood_random2d one_random2d random3d aug_liver liver one_liver}"
+: "${CONFIGS=$(ls configs/examples/*.yaml)}"
 BIN=$HYPERSHAPE_BIN
 export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
 
@@ -46,6 +49,19 @@ for preset in $PRESETS; do
   /usr/bin/python3 scripts/hypershape_data.py plot "$dir" --gallery 4 -o "$OUT_DIR/${preset}_solutions.png"
   echo "   $preset: generate --mini ${t_gen} s, plot $(seconds_since "$t0") s"
   made+=("$preset")
+done
+# The example datasets beyond the paper (configs/examples: several tractions with fixed gravity,
+# the effects catalogue), generated as they are (they are small) -> <name>_solutions.png.
+for config in $CONFIGS; do
+  name=$(basename "$config" .yaml)
+  dir="$DATA_DIR/$name"
+  rm -rf "$dir"
+  t0=$(date +%s.%N)
+  "$BIN" -q generate "$config" --progress 0 -o "$dir"
+  t_gen=$(seconds_since "$t0")
+  /usr/bin/python3 scripts/hypershape_data.py plot "$dir" --gallery 4 -o "$OUT_DIR/${name}_solutions.png"
+  echo "   $name: generate ${t_gen} s"
+  made+=("$name")
 done
 echo "figures in $OUT_DIR for: ${made[*]:-none}"
 if [[ ${#skipped[@]} -gt 0 ]]; then printf 'skipped: %s\n' "${skipped[@]}"; fi
