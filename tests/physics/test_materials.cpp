@@ -105,7 +105,7 @@ void check_objectivity(const K& m) {
   for (int sample = 0; sample < 6; ++sample) {
     const Tensor<D> Q = hstest::random_rotation<D>(rng);
     const Tensor<D> F = random_f<D>(rng);
-    double W, WQ;
+    double W = 0, WQ = 0;
     Tensor<D> P, PQ;
     REQUIRE((m.energy(F, W) && m.energy(Q * F, WQ) && m.stress(F, P) && m.stress(Q * F, PQ)));
     CHECK(std::abs(WQ - W) <= 1e-12 * std::abs(W));
@@ -120,7 +120,7 @@ void check_plane_strain(const K2& m2, const K3& m3) {
   const Tensor<2> F = random_f<2>(rng);
   Tensor<3> F3 = Tensor<3>::Identity();
   F3.topLeftCorner<2, 2>() = F;
-  double W2, W3;
+  double W2 = 0, W3 = 0;
   Tensor<2> P2;
   Tensor<3> P3;
   REQUIRE((m2.energy(F, W2) && m3.energy(F3, W3) && m2.stress(F, P2) && m3.stress(F3, P3)));
