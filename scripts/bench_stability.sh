@@ -45,7 +45,7 @@ for c in ${CONFIGS:-}; do run_config "$c"; done
 for s in ${SEEDS:-}; do run random2d "$shapes2" 50 "$s"; done
 [ -z "${SEEDS:-}${CONFIGS:-}" ] && run random2d "$shapes2" 50 ""
 if [ "$shapes3" -gt 0 ]; then
-  for s in ${SEEDS3D:-""}; do run random3d "$shapes3" 20 "$s"; done
+  for s in ${SEEDS3D:-}; do run random3d "$shapes3" 20 "$s"; done
   [ -z "${SEEDS3D:-}" ] && run random3d "$shapes3" 20 ""
 fi
 mkdir -p results
