@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "hypershape/core/error.hpp"
+#include "hypershape/core/vec_array.hpp"
 #include "hypershape/mesh/plex.hpp"
 #include "hypershape/physics/hyperelastic.hpp"
 
@@ -15,38 +16,7 @@ namespace hypershape::physics {
 
 namespace {
 
-/// Borrowed local vector with array access, restored on scope exit.
-class LocalArray {
- public:
-  LocalArray(DM dm, bool write) : dm_(dm), write_(write) {
-    HS_PETSC(DMGetLocalVector(dm, &v_));
-    if (write) HS_PETSC(VecZeroEntries(v_));
-  }
-  ~LocalArray() {
-    if (a_) write_ ? VecRestoreArray(v_, &a_) : VecRestoreArrayRead(v_, (const PetscScalar**)&a_);
-    DMRestoreLocalVector(dm_, &v_);
-  }
-  Vec vec() const { return v_; }
-  PetscScalar* array() {
-    if (!a_) {
-      if (write_) HS_PETSC(VecGetArray(v_, &a_));
-      else HS_PETSC(VecGetArrayRead(v_, (const PetscScalar**)&a_));
-    }
-    return a_;
-  }
-  void release() {
-    if (a_) {
-      write_ ? VecRestoreArray(v_, &a_) : VecRestoreArrayRead(v_, (const PetscScalar**)&a_);
-      a_ = nullptr;
-    }
-  }
-
- private:
-  DM dm_;
-  Vec v_ = nullptr;
-  PetscScalar* a_ = nullptr;
-  bool write_;
-};
+using core::LocalArray;
 
 /// m += x × f (3-vectors; 2D vectors have a zero third component).
 void add_moment(const double* x, const double* f, std::array<double, 3>& m) {
@@ -210,11 +180,10 @@ Resultants Problem::resultants(Vec u, double load_factor) const {
   // constrained entries, which the global layout drops, are still there.
   PetscSection ls, cs;
   Vec coords;
-  const PetscScalar* xa;
   HS_PETSC(DMGetLocalSection(dm(), &ls));
   HS_PETSC(DMGetCoordinateSection(dm(), &cs));
   HS_PETSC(DMGetCoordinatesLocal(dm(), &coords));
-  HS_PETSC(VecGetArrayRead(coords, &xa));
+  const core::VecArray<const PetscScalar> xa(coords);
   const PetscScalar *a = ul.array(), *f_int = fi.array(), *f_ext = fe.array(), *f_fix = ff.array();
   PetscInt p0, p1;
   HS_PETSC(PetscSectionGetChart(ls, &p0, &p1));
@@ -224,7 +193,7 @@ Resultants Problem::resultants(Vec u, double load_factor) const {
     if (n_dof == 0) continue;
     HS_PETSC(PetscSectionGetOffset(ls, p, &off));
     HS_PETSC(PetscSectionGetConstraintDof(ls, p, &n_con));
-    const std::array<double, 3> x = Space::node_coords(dm(), cs, xa, p, dim);
+    const std::array<double, 3> x = Space::node_coords(dm(), cs, xa.data(), p, dim);
     double y[3] = {0, 0, 0}, load[3] = {0, 0, 0}, support[3] = {0, 0, 0};
     for (int i = 0; i < dim; ++i) {
       y[i] = x[i] + PetscRealPart(a[off + i]);
@@ -243,7 +212,6 @@ Resultants Problem::resultants(Vec u, double load_factor) const {
     }
     add_moment(y, support, out.reaction_moment);
   }
-  HS_PETSC(VecRestoreArrayRead(coords, &xa));
   for (auto* v : {&out.reaction_force, &out.reaction_moment, &out.applied_force,
                   &out.applied_moment, &out.applied_moment_reference})
     MPI_Allreduce(MPI_IN_PLACE, v->data(), 3, MPI_DOUBLE, MPI_SUM, comm());
@@ -270,7 +238,7 @@ double Problem::min_det_f(Vec u) const {
   const PetscScalar* a = ul.array();
   const Space& s = *space_;
   double m = INFINITY;
-  detail::dispatch<NeoHookean>(s, [&]<int D, int NB>() {
+  detail::dispatch(s, [&]<int D, int NB>() {
     Eigen::Matrix<double, NB, D> ue, G;
     for (PetscInt c = s.cell_begin(); c < s.cell_end(); ++c) {
       detail::gather<D, NB>(s, c, a, ue);

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "hypershape/core/error.hpp"
+#include "hypershape/core/vec_array.hpp"
 #include "hypershape/mesh/plex.hpp"
 
 namespace hypershape::physics {
@@ -81,21 +82,153 @@ std::array<double, 3> Space::node_coords(DM dm, PetscSection cs, const PetscScal
 }
 
 
+namespace detail {
+
+/// The canonical (rank-independent) node ids: the serial plex's vertices in order, then (P2)
+/// its edges in order. Known on every rank (strata broadcast from rank 0).
+struct CanonicalIds {
+  PetscInt strata[4] = {0, 0, 0, 0};  // serial vStart, vEnd, eStart, eEnd
+  std::int64_t n_vertices() const { return strata[1] - strata[0]; }
+  std::int64_t operator()(PetscInt serial_point) const {
+    if (serial_point >= strata[0] && serial_point < strata[1]) return serial_point - strata[0];
+    return n_vertices() + (serial_point - strata[2]);
+  }
+};
+
+CanonicalIds canonical_ids(DM serial, MPI_Comm comm) {
+  CanonicalIds ids;
+  if (core::rank(comm) == 0) {
+    HS_PETSC(DMPlexGetDepthStratum(serial, 0, &ids.strata[0], &ids.strata[1]));
+    HS_PETSC(DMPlexGetDepthStratum(serial, 1, &ids.strata[2], &ids.strata[3]));
+  }
+  MPI_Bcast(ids.strata, 4, MPIU_INT, 0, comm);
+  return ids;
+}
+
+}  // namespace detail
+
+namespace {
+
+
+/// For each local point of `dm`, the serial plex's point it came from (through `migration`,
+/// the SF of DMPlexDistribute; the identity without one).
+std::vector<PetscInt> serial_points(DM dm, DM serial, PetscSF migration) {
+  PetscInt p_start, p_end;
+  HS_PETSC(DMPlexGetChart(dm, &p_start, &p_end));
+  std::vector<PetscInt> original(std::size_t(p_end - p_start));
+  if (!migration) {
+    for (PetscInt p = p_start; p < p_end; ++p) original[p - p_start] = p;
+    return original;
+  }
+  PetscInt s0 = 0, s1 = 0;
+  HS_PETSC(DMPlexGetChart(serial, &s0, &s1));
+  std::vector<PetscInt> identity(std::size_t(s1 - s0));
+  for (PetscInt p = s0; p < s1; ++p) identity[p - s0] = p;
+  HS_PETSC(PetscSFBcastBegin(migration, MPIU_INT, identity.data(), original.data(), MPI_REPLACE));
+  HS_PETSC(PetscSFBcastEnd(migration, MPIU_INT, identity.data(), original.data(), MPI_REPLACE));
+  return original;
+}
+
+/// 1 for the points of `dm` that are ghosts (leaves of the point SF), else 0.
+std::vector<char> ghost_points(DM dm) {
+  PetscInt p_start, p_end, n_roots, n_leaves;
+  HS_PETSC(DMPlexGetChart(dm, &p_start, &p_end));
+  PetscSF point_sf;
+  HS_PETSC(DMGetPointSF(dm, &point_sf));
+  const PetscInt* leaves;
+  HS_PETSC(PetscSFGetGraph(point_sf, &n_roots, &n_leaves, &leaves, nullptr));
+  std::vector<char> ghost(std::size_t(p_end - p_start), 0);
+  for (PetscInt i = 0; i < n_leaves && n_leaves > 0; ++i) ghost[(leaves ? leaves[i] : i) - p_start] = 1;
+  return ghost;
+}
+
+/// The labels of the essential conditions (a facet carrying one is not a Neumann facet).
+std::vector<DMLabel> essential_labels(DM dm, const std::vector<EssentialBC>& bcs) {
+  std::vector<DMLabel> ess;
+  for (const auto& bc : bcs) {
+    DMLabel l;
+    HS_PETSC(DMGetLabel(dm, bc.label.c_str(), &l));
+    ess.push_back(l);
+  }
+  return ess;
+}
+
+bool carries_any(const std::vector<DMLabel>& labels, PetscInt point) {
+  bool any = false;
+  for (DMLabel l : labels) {
+    PetscInt val;
+    HS_PETSC(DMLabelGetValue(l, point, &val));
+    any = any || val == 1;
+  }
+  return any;
+}
+
+/// Facet `f` as the surface integrators see it: vertices, outward normal, and each dof-carrying
+/// closure point's local offset and the facet vertices it lies between.
+FacetView facet_view(DM dm, PetscSection ls, PetscSection cs, const PetscScalar* xa, PetscInt f,
+                     PetscInt v0, PetscInt v1, int dim) {
+  FacetView fv{};
+  fv.point = f;
+  const auto verts = closure_of_depth(dm, f, v0, v1);
+  fv.n_vertices = int(verts.size());
+  for (int a = 0; a < fv.n_vertices; ++a) fv.x[a] = vertex_coords(cs, xa, verts[a], dim);
+  fv.normal = outward_normal(dm, cs, xa, fv, v0, v1, dim);
+  auto index_of = [&](PetscInt v) { return int(std::find(verts.begin(), verts.end(), v) - verts.begin()); };
+  PetscInt n, *cl = nullptr;
+  HS_PETSC(DMPlexGetTransitiveClosure(dm, f, PETSC_TRUE, &n, &cl));
+  fv.n_nodes = 0;
+  for (PetscInt j = 0; j < n; ++j) {
+    const PetscInt p = cl[2 * j];
+    PetscInt dof, off;
+    HS_PETSC(PetscSectionGetDof(ls, p, &dof));
+    if (dof == 0) continue;
+    HS_PETSC(PetscSectionGetOffset(ls, p, &off));
+    std::array<int, 2> ends{};
+    if (p >= v0 && p < v1) {
+      ends = {index_of(p), index_of(p)};
+    } else {
+      const PetscInt* cone;
+      HS_PETSC(DMPlexGetCone(dm, p, &cone));
+      ends = {index_of(cone[0]), index_of(cone[1])};
+    }
+    fv.offset[fv.n_nodes] = off;
+    fv.ends[fv.n_nodes] = ends;
+    ++fv.n_nodes;
+  }
+  HS_PETSC(DMPlexRestoreTransitiveClosure(dm, f, PETSC_TRUE, &n, &cl));
+  return fv;
+}
+
+}  // namespace
+
 Space::Space(core::DMH dm, DM serial, PetscSF migration, const SpaceOptions& opt,
              const std::vector<EssentialBC>& bcs)
     : dm_(std::move(dm)), degree_(opt.degree) {
   if (degree_ != 1 && degree_ != 2) throw std::invalid_argument("degree must be 1 or 2");
-  MPI_Comm cm = comm();
   PetscInt d;
   HS_PETSC(DMGetDimension(dm_, &d));
   dim_ = int(d);
   n_nodes_ = degree_ == 1 ? dim_ + 1 : (dim_ + 1) * (dim_ + 2) / 2;
+  core::QuadH q, fq;
+  create_fe(opt, bcs, q, fq);
+  tabulate_cell_rule(q);
+  tabulate_facet_rule(fq);
+  build_cells();
+  Vec coords;
+  PetscSection cs;
+  HS_PETSC(DMGetCoordinatesLocal(dm_, &coords));
+  HS_PETSC(DMGetCoordinateSection(dm_, &cs));
+  const core::VecArray<const PetscScalar> xa(coords);
+  collect_neumann_facets(bcs, cs, xa.data());
+  number_nodes(serial, migration, cs, xa.data());
+}
 
+void Space::create_fe(const SpaceOptions& opt, const std::vector<EssentialBC>& bcs, core::QuadH& q,
+                      core::QuadH& fq) {
   // Finite element with minimal symmetric rules (PETSc's default rules are 3-8x larger).
   const int qdeg = opt.quadrature_degree > 0 ? opt.quadrature_degree : 2 * degree_ - 1;
   const int fqdeg = opt.facet_quadrature_degree > 0 ? opt.facet_quadrature_degree : 2 * degree_ + 2;
-  HS_PETSC(PetscFECreateLagrange(cm, dim_, dim_, PETSC_TRUE, degree_, PETSC_DETERMINE, fe_.out()));
-  core::QuadH q, fq;
+  HS_PETSC(PetscFECreateLagrange(comm(), dim_, dim_, PETSC_TRUE, degree_, PETSC_DETERMINE, fe_.out()));
   HS_PETSC(PetscDTSimplexQuadrature(dim_, qdeg, PETSCDTSIMPLEXQUAD_MINSYM, q.out()));
   HS_PETSC(PetscDTSimplexQuadrature(dim_ - 1, fqdeg, PETSCDTSIMPLEXQUAD_MINSYM, fq.out()));
   HS_PETSC(PetscFESetQuadrature(fe_, q));
@@ -113,49 +246,52 @@ Space::Space(core::DMH dm, DM serial, PetscSF migration, const SpaceOptions& opt
                            (void (*)(void))zero_value, nullptr, nullptr, nullptr));
   }
   HS_PETSC(DMPlexCreateClosureIndex(dm_, nullptr));
+}
 
+void Space::tabulate_cell_rule(PetscQuadrature q) {
   // Reference basis at the quadrature points (closure order = PETSc's dof order).
-  {
-    PetscInt qd, qnc, np;
-    const PetscReal *pts, *wts;
-    HS_PETSC(PetscQuadratureGetData(q, &qd, &qnc, &np, &pts, &wts));
-    n_qp_ = int(np);
-    qw_.assign(wts, wts + np);
-    qxi_.assign(pts, pts + np * dim_);
-    PetscTabulation T;
-    HS_PETSC(PetscFECreateTabulation(fe_, 1, np, pts, 1, &T));
-    const PetscInt nb = T->Nb, nc = T->Nc;
-    if (nb != n_nodes_ * dim_ || nc != dim_) throw std::logic_error("unexpected tabulation size");
-    N_.resize(std::size_t(np) * n_nodes_);
-    dN_.resize(std::size_t(np) * n_nodes_ * dim_);
-    for (int iq = 0; iq < n_qp_; ++iq)
-      for (int a = 0; a < n_nodes_; ++a) {
-        const PetscInt b = a * nc;  // component-0 function of node a, component 0
-        N_[iq * n_nodes_ + a] = T->T[0][(iq * nb + b) * nc + 0];
-        for (int k = 0; k < dim_; ++k)
-          dN_[(std::size_t(iq) * n_nodes_ + a) * dim_ + k] = T->T[1][((iq * nb + b) * nc + 0) * dim_ + k];
-      }
-    HS_PETSC(PetscTabulationDestroy(&T));
-  }
-  {
-    PetscInt qd, qnc, np;
-    const PetscReal *pts, *wts;
-    HS_PETSC(PetscQuadratureGetData(fq, &qd, &qnc, &np, &pts, &wts));
-    double wsum = 0;
-    for (PetscInt i = 0; i < np; ++i) wsum += wts[i];
-    for (PetscInt i = 0; i < np; ++i) {
-      fqw_.push_back(wts[i] / wsum);
-      double l0 = 1.0;
-      std::array<double, 3> bary{};
-      for (int k = 0; k < dim_ - 1; ++k) {
-        bary[k + 1] = 0.5 * (pts[i * (dim_ - 1) + k] + 1.0);
-        l0 -= bary[k + 1];
-      }
-      bary[0] = l0;
-      for (int k = 0; k < dim_; ++k) fbary_.push_back(bary[k]);
+  PetscInt qd, qnc, np;
+  const PetscReal *pts, *wts;
+  HS_PETSC(PetscQuadratureGetData(q, &qd, &qnc, &np, &pts, &wts));
+  n_qp_ = int(np);
+  qw_.assign(wts, wts + np);
+  qxi_.assign(pts, pts + np * dim_);
+  PetscTabulation T;
+  HS_PETSC(PetscFECreateTabulation(fe_, 1, np, pts, 1, &T));
+  const PetscInt nb = T->Nb, nc = T->Nc;
+  if (nb != n_nodes_ * dim_ || nc != dim_) throw std::logic_error("unexpected tabulation size");
+  N_.resize(std::size_t(np) * n_nodes_);
+  dN_.resize(std::size_t(np) * n_nodes_ * dim_);
+  for (int iq = 0; iq < n_qp_; ++iq)
+    for (int a = 0; a < n_nodes_; ++a) {
+      const PetscInt b = a * nc;  // component-0 function of node a, component 0
+      N_[iq * n_nodes_ + a] = T->T[0][(iq * nb + b) * nc + 0];
+      for (int k = 0; k < dim_; ++k)
+        dN_[(std::size_t(iq) * n_nodes_ + a) * dim_ + k] = T->T[1][((iq * nb + b) * nc + 0) * dim_ + k];
     }
-  }
+  HS_PETSC(PetscTabulationDestroy(&T));
+}
 
+void Space::tabulate_facet_rule(PetscQuadrature fq) {
+  PetscInt qd, qnc, np;
+  const PetscReal *pts, *wts;
+  HS_PETSC(PetscQuadratureGetData(fq, &qd, &qnc, &np, &pts, &wts));
+  double wsum = 0;
+  for (PetscInt i = 0; i < np; ++i) wsum += wts[i];
+  for (PetscInt i = 0; i < np; ++i) {
+    fqw_.push_back(wts[i] / wsum);
+    double l0 = 1.0;
+    std::array<double, 3> bary{};
+    for (int k = 0; k < dim_ - 1; ++k) {
+      bary[k + 1] = 0.5 * (pts[i * (dim_ - 1) + k] + 1.0);
+      l0 -= bary[k + 1];
+    }
+    bary[0] = l0;
+    for (int k = 0; k < dim_; ++k) fbary_.push_back(bary[k]);
+  }
+}
+
+void Space::build_cells() {
   // Per-cell geometry and dof indices.
   PetscSection ls, gs;
   HS_PETSC(DMGetLocalSection(dm_, &ls));
@@ -167,8 +303,6 @@ Space::Space(core::DMH dm, DM serial, PetscSF migration, const SpaceOptions& opt
   v0_.resize(std::size_t(nloc) * dim_);
   ldofs_.resize(std::size_t(nloc) * n_cell_dofs());
   gdofs_.resize(std::size_t(nloc) * n_cell_dofs());
-  PetscInt p_start, p_end;
-  HS_PETSC(DMPlexGetChart(dm_, &p_start, &p_end));
   for (PetscInt c = c0_; c < c1_; ++c) {
     double v0[3], J[9], iJ[9], detJ;
     HS_PETSC(DMPlexComputeCellGeometryAffineFEM(dm_, c, v0, J, iJ, &detJ));
@@ -176,191 +310,113 @@ Space::Space(core::DMH dm, DM serial, PetscSF migration, const SpaceOptions& opt
     std::copy(iJ, iJ + dim_ * dim_, &invJ_[std::size_t(c - c0_) * dim_ * dim_]);
     std::copy(v0, v0 + dim_, &v0_[std::size_t(c - c0_) * dim_]);
     detJ_[c - c0_] = detJ;
-    PetscInt n, *cl = nullptr, k = 0;
-    HS_PETSC(DMPlexGetTransitiveClosure(dm_, c, PETSC_TRUE, &n, &cl));
-    PetscInt* ld = &ldofs_[std::size_t(c - c0_) * n_cell_dofs()];
-    for (PetscInt i = 0; i < n; ++i) {
-      PetscInt dof, off;
-      HS_PETSC(PetscSectionGetDof(ls, cl[2 * i], &dof));
-      HS_PETSC(PetscSectionGetOffset(ls, cl[2 * i], &off));
-      for (PetscInt j = 0; j < dof; ++j) {
-        if (k >= n_cell_dofs()) throw std::logic_error("closure has too many dofs");
-        ld[k++] = off + j;
-      }
-    }
-    HS_PETSC(DMPlexRestoreTransitiveClosure(dm_, c, PETSC_TRUE, &n, &cl));
-    if (k != n_cell_dofs()) throw std::logic_error("closure has too few dofs");
-    PetscInt ni, *idx = nullptr;
-    HS_PETSC(DMPlexGetClosureIndices(dm_, ls, gs, c, PETSC_TRUE, &ni, &idx, nullptr, nullptr));
-    if (ni != n_cell_dofs()) throw std::logic_error("closure index count mismatch");
-    std::copy(idx, idx + ni, &gdofs_[std::size_t(c - c0_) * n_cell_dofs()]);
-    HS_PETSC(DMPlexRestoreClosureIndices(dm_, ls, gs, c, PETSC_TRUE, &ni, &idx, nullptr, nullptr));
+    cell_dofs(c, ls, gs);
   }
   long long nc_loc = nloc;
-  MPI_Allreduce(MPI_IN_PLACE, &nc_loc, 1, MPI_LONG_LONG, MPI_SUM, cm);
+  MPI_Allreduce(MPI_IN_PLACE, &nc_loc, 1, MPI_LONG_LONG, MPI_SUM, comm());
   n_cells_global_ = nc_loc;
-  {
-    Vec g;
-    PetscInt n;
-    HS_PETSC(DMGetGlobalVector(dm_, &g));
-    HS_PETSC(VecGetSize(g, &n));
-    HS_PETSC(DMRestoreGlobalVector(dm_, &g));
-    n_dofs_global_ = n;
+  Vec g;
+  PetscInt n;
+  HS_PETSC(DMGetGlobalVector(dm_, &g));
+  HS_PETSC(VecGetSize(g, &n));
+  HS_PETSC(DMRestoreGlobalVector(dm_, &g));
+  n_dofs_global_ = n;
+}
+
+void Space::cell_dofs(PetscInt c, PetscSection ls, PetscSection gs) {
+  PetscInt n, *cl = nullptr, k = 0;
+  HS_PETSC(DMPlexGetTransitiveClosure(dm_, c, PETSC_TRUE, &n, &cl));
+  PetscInt* ld = &ldofs_[std::size_t(c - c0_) * n_cell_dofs()];
+  for (PetscInt i = 0; i < n; ++i) {
+    PetscInt dof, off;
+    HS_PETSC(PetscSectionGetDof(ls, cl[2 * i], &dof));
+    HS_PETSC(PetscSectionGetOffset(ls, cl[2 * i], &off));
+    for (PetscInt j = 0; j < dof; ++j) {
+      if (k >= n_cell_dofs()) throw std::logic_error("closure has too many dofs");
+      ld[k++] = off + j;
+    }
   }
+  HS_PETSC(DMPlexRestoreTransitiveClosure(dm_, c, PETSC_TRUE, &n, &cl));
+  if (k != n_cell_dofs()) throw std::logic_error("closure has too few dofs");
+  PetscInt ni, *idx = nullptr;
+  HS_PETSC(DMPlexGetClosureIndices(dm_, ls, gs, c, PETSC_TRUE, &ni, &idx, nullptr, nullptr));
+  if (ni != n_cell_dofs()) throw std::logic_error("closure index count mismatch");
+  std::copy(idx, idx + ni, &gdofs_[std::size_t(c - c0_) * n_cell_dofs()]);
+  HS_PETSC(DMPlexRestoreClosureIndices(dm_, ls, gs, c, PETSC_TRUE, &ni, &idx, nullptr, nullptr));
+}
 
-  // Coordinates.
-  Vec coords;
-  PetscSection cs;
-  const PetscScalar* xa;
-  HS_PETSC(DMGetCoordinatesLocal(dm_, &coords));
-  HS_PETSC(DMGetCoordinateSection(dm_, &cs));
-  HS_PETSC(VecGetArrayRead(coords, &xa));
-
+void Space::collect_neumann_facets(const std::vector<EssentialBC>& bcs, PetscSection cs, const PetscScalar* xa) {
   // Neumann facets: boundary facets carrying none of the essential labels.
-  {
-    std::vector<DMLabel> ess;
-    for (const auto& bc : bcs) {
-      DMLabel l;
-      HS_PETSC(DMGetLabel(dm_, bc.label.c_str(), &l));
-      ess.push_back(l);
-    }
-    PetscInt v0, v1;
-    HS_PETSC(DMPlexGetDepthStratum(dm_, 0, &v0, &v1));
-    IS facets = nullptr;
-    HS_PETSC(DMGetStratumIS(dm_, mesh::boundary_label, 1, &facets));
-    PetscInt nf = 0;
-    const PetscInt* fp = nullptr;
-    if (facets) {
-      HS_PETSC(ISGetLocalSize(facets, &nf));
-      HS_PETSC(ISGetIndices(facets, &fp));
-    }
-    for (PetscInt i = 0; i < nf; ++i) {
-      const PetscInt f = fp[i];
-      bool constrained = false;
-      for (DMLabel l : ess) {
-        PetscInt val;
-        HS_PETSC(DMLabelGetValue(l, f, &val));
-        constrained = constrained || val == 1;
-      }
-      if (constrained) continue;
-      FacetView fv{};
-      fv.point = f;
-      auto verts = closure_of_depth(dm_, f, v0, v1);
-      fv.n_vertices = int(verts.size());
-      for (int a = 0; a < fv.n_vertices; ++a) fv.x[a] = vertex_coords(cs, xa, verts[a], dim_);
-      fv.normal = outward_normal(dm_, cs, xa, fv, v0, v1, dim_);
-      PetscInt n, *cl = nullptr;
-      HS_PETSC(DMPlexGetTransitiveClosure(dm_, f, PETSC_TRUE, &n, &cl));
-      fv.n_nodes = 0;
-      for (PetscInt j = 0; j < n; ++j) {
-        const PetscInt p = cl[2 * j];
-        PetscInt dof, off;
-        HS_PETSC(PetscSectionGetDof(ls, p, &dof));
-        if (dof == 0) continue;
-        HS_PETSC(PetscSectionGetOffset(ls, p, &off));
-        std::array<int, 2> ends{};
-        if (p >= v0 && p < v1) {
-          const int a = int(std::find(verts.begin(), verts.end(), p) - verts.begin());
-          ends = {a, a};
-        } else {
-          const PetscInt* cone;
-          HS_PETSC(DMPlexGetCone(dm_, p, &cone));
-          ends = {int(std::find(verts.begin(), verts.end(), cone[0]) - verts.begin()),
-                  int(std::find(verts.begin(), verts.end(), cone[1]) - verts.begin())};
-        }
-        fv.offset[fv.n_nodes] = off;
-        fv.ends[fv.n_nodes] = ends;
-        ++fv.n_nodes;
-      }
-      HS_PETSC(DMPlexRestoreTransitiveClosure(dm_, f, PETSC_TRUE, &n, &cl));
-      neumann_facets_.push_back(fv);
-    }
-    if (facets) {
-      HS_PETSC(ISRestoreIndices(facets, &fp));
-      HS_PETSC(ISDestroy(&facets));
-    }
-  }
+  const std::vector<DMLabel> ess = essential_labels(dm_, bcs);
+  PetscSection ls;
+  HS_PETSC(DMGetLocalSection(dm_, &ls));
+  PetscInt v0, v1;
+  HS_PETSC(DMPlexGetDepthStratum(dm_, 0, &v0, &v1));
+  IS facets = nullptr;
+  HS_PETSC(DMGetStratumIS(dm_, mesh::boundary_label, 1, &facets));
+  if (!facets) return;
+  PetscInt nf = 0;
+  const PetscInt* fp = nullptr;
+  HS_PETSC(ISGetLocalSize(facets, &nf));
+  HS_PETSC(ISGetIndices(facets, &fp));
+  for (PetscInt i = 0; i < nf; ++i)
+    if (!carries_any(ess, fp[i])) neumann_facets_.push_back(facet_view(dm_, ls, cs, xa, fp[i], v0, v1, dim_));
+  HS_PETSC(ISRestoreIndices(facets, &fp));
+  HS_PETSC(ISDestroy(&facets));
+}
 
+void Space::number_nodes(DM serial, PetscSF migration, PetscSection cs, const PetscScalar* xa) {
   // Canonical numbering: vertices of the serial plex in order, then (P2) its edges in order.
-  const bool root = core::rank(cm) == 0;
-  PetscInt strata[4] = {0, 0, 0, 0};  // serial vStart, vEnd, eStart, eEnd
-  if (root) {
-    HS_PETSC(DMPlexGetDepthStratum(serial, 0, &strata[0], &strata[1]));
-    HS_PETSC(DMPlexGetDepthStratum(serial, 1, &strata[2], &strata[3]));
+  const detail::CanonicalIds canonical = detail::canonical_ids(serial, comm());
+  n_vertices_global_ = canonical.n_vertices();
+  n_nodes_global_ = n_vertices_global_ + (degree_ == 2 ? canonical.strata[3] - canonical.strata[2] : 0);
+  const std::vector<PetscInt> original = serial_points(dm_, serial, migration);
+  const std::vector<char> ghost = ghost_points(dm_);
+  PetscSection ls;
+  HS_PETSC(DMGetLocalSection(dm_, &ls));
+  PetscInt p_start, p_end;
+  HS_PETSC(DMPlexGetChart(dm_, &p_start, &p_end));
+  for (PetscInt p = p_start; p < p_end; ++p) {
+    PetscInt dof, off;
+    HS_PETSC(PetscSectionGetDof(ls, p, &dof));
+    if (dof == 0 || ghost[p - p_start]) continue;
+    HS_PETSC(PetscSectionGetOffset(ls, p, &off));
+    owned_nodes_.push_back({off, canonical(original[p - p_start]), node_coords(dm_, cs, xa, p, dim_)});
   }
-  MPI_Bcast(strata, 4, MPIU_INT, 0, cm);
-  n_vertices_global_ = strata[1] - strata[0];
-  n_nodes_global_ = n_vertices_global_ + (degree_ == 2 ? strata[3] - strata[2] : 0);
-  std::vector<PetscInt> original(std::size_t(p_end - p_start));
-  if (migration) {
-    PetscInt s0 = 0, s1 = 0;
-    HS_PETSC(DMPlexGetChart(serial, &s0, &s1));
-    std::vector<PetscInt> identity(std::size_t(s1 - s0));
-    for (PetscInt p = s0; p < s1; ++p) identity[p - s0] = p;
-    HS_PETSC(PetscSFBcastBegin(migration, MPIU_INT, identity.data(), original.data(), MPI_REPLACE));
-    HS_PETSC(PetscSFBcastEnd(migration, MPIU_INT, identity.data(), original.data(), MPI_REPLACE));
-  } else {
-    for (PetscInt p = p_start; p < p_end; ++p) original[p - p_start] = p;
-  }
-  auto canonical = [&](PetscInt orig) -> std::int64_t {
-    if (orig >= strata[0] && orig < strata[1]) return orig - strata[0];
-    return n_vertices_global_ + (orig - strata[2]);
-  };
-  {
-    PetscSF point_sf;
-    HS_PETSC(DMGetPointSF(dm_, &point_sf));
-    PetscInt n_roots, n_leaves;
-    const PetscInt* leaves;
-    HS_PETSC(PetscSFGetGraph(point_sf, &n_roots, &n_leaves, &leaves, nullptr));
-    std::vector<char> ghost(std::size_t(p_end - p_start), 0);
-    for (PetscInt i = 0; i < n_leaves && n_leaves > 0; ++i)
-      ghost[(leaves ? leaves[i] : i) - p_start] = 1;
-    for (PetscInt p = p_start; p < p_end; ++p) {
-      PetscInt dof, off;
-      HS_PETSC(PetscSectionGetDof(ls, p, &dof));
-      if (dof == 0 || ghost[p - p_start]) continue;
-      HS_PETSC(PetscSectionGetOffset(ls, p, &off));
-      owned_nodes_.push_back({off, canonical(original[p - p_start]), node_coords(dm_, cs, xa, p, dim_)});
-    }
-  }
-  HS_PETSC(VecRestoreArrayRead(coords, &xa));
+  if (core::rank(comm()) == 0) build_output_mesh(serial, canonical);
+}
 
+void Space::build_output_mesh(DM serial, const detail::CanonicalIds& canonical) {
   // Canonical connectivity and coordinates for output, from the serial plex (rank 0).
-  if (root) {
-    Vec sc;
-    PetscSection scs;
-    const PetscScalar* sxa;
-    HS_PETSC(DMGetCoordinatesLocal(serial, &sc));
-    HS_PETSC(DMGetCoordinateSection(serial, &scs));
-    HS_PETSC(VecGetArrayRead(sc, &sxa));
-    canonical_coords_.resize(std::size_t(n_nodes_global_) * dim_);
-    for (PetscInt p = strata[0]; p < strata[1]; ++p) {
-      auto x = vertex_coords(scs, sxa, p, dim_);
-      std::copy(x.begin(), x.begin() + dim_, &canonical_coords_[std::size_t(p - strata[0]) * dim_]);
+  const PetscInt* strata = canonical.strata;
+  Vec sc;
+  PetscSection scs;
+  HS_PETSC(DMGetCoordinatesLocal(serial, &sc));
+  HS_PETSC(DMGetCoordinateSection(serial, &scs));
+  const core::VecArray<const PetscScalar> sxa(sc);
+  canonical_coords_.resize(std::size_t(n_nodes_global_) * dim_);
+  auto store = [&](PetscInt p) {
+    const auto x = node_coords(serial, scs, sxa.data(), p, dim_);
+    std::copy(x.begin(), x.begin() + dim_, &canonical_coords_[std::size_t(canonical(p)) * dim_]);
+  };
+  for (PetscInt p = strata[0]; p < strata[1]; ++p) store(p);
+  if (degree_ == 2)
+    for (PetscInt p = strata[2]; p < strata[3]; ++p) store(p);
+  PetscInt sc0, sc1;
+  HS_PETSC(DMPlexGetHeightStratum(serial, 0, &sc0, &sc1));
+  for (PetscInt c = sc0; c < sc1; ++c) {
+    auto v = closure_of_depth(serial, c, strata[0], strata[1]);
+    if (dim_ == 3) std::swap(v[1], v[2]);  // PETSc's left-handed tetrahedra -> VTK's
+    for (auto p : v) canonical_cells_.push_back(canonical(p));
+    if (degree_ != 2) continue;
+    for (const auto& [a, b] : mesh::edges(dim_)) {
+      const PetscInt pair[2] = {v[a], v[b]};
+      PetscInt nj;
+      const PetscInt* join;
+      HS_PETSC(DMPlexGetJoin(serial, 2, pair, &nj, &join));
+      canonical_cells_.push_back(canonical(join[0]));
+      HS_PETSC(DMPlexRestoreJoin(serial, 2, pair, &nj, &join));
     }
-    if (degree_ == 2)
-      for (PetscInt p = strata[2]; p < strata[3]; ++p) {
-        auto x = node_coords(serial, scs, sxa, p, dim_);
-        std::copy(x.begin(), x.begin() + dim_, &canonical_coords_[std::size_t(canonical(p)) * dim_]);
-      }
-    PetscInt sc0, sc1;
-    HS_PETSC(DMPlexGetHeightStratum(serial, 0, &sc0, &sc1));
-    for (PetscInt c = sc0; c < sc1; ++c) {
-      auto v = closure_of_depth(serial, c, strata[0], strata[1]);
-      if (dim_ == 3) std::swap(v[1], v[2]);  // PETSc's left-handed tetrahedra -> VTK's
-      for (auto p : v) canonical_cells_.push_back(canonical(p));
-      if (degree_ == 2) {
-        for (const auto& [a, b] : mesh::edges(dim_)) {
-          const PetscInt pair[2] = {v[a], v[b]};
-          PetscInt nj;
-          const PetscInt* join;
-          HS_PETSC(DMPlexGetJoin(serial, 2, pair, &nj, &join));
-          canonical_cells_.push_back(canonical(join[0]));
-          HS_PETSC(DMPlexRestoreJoin(serial, 2, pair, &nj, &join));
-        }
-      }
-    }
-    HS_PETSC(VecRestoreArrayRead(sc, &sxa));
   }
 }
 

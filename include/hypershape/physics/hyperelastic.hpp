@@ -2,7 +2,7 @@
 /// Hand-written, fixed-size element loops for any hyperelastic kernel `K<D>` with
 ///   bool energy(F, W), bool stress(F, P), bool stress_tangent(F, P, A),
 ///   std::vector<double> constants(), static K<D> from_constants(const PetscScalar*)
-/// (see neo_hookean.hpp). Total Lagrangian: the reference geometry is fixed, so everything
+/// (see tensor.hpp, neo_hookean.hpp). Total Lagrangian: the reference geometry is fixed, so everything
 /// geometric comes precomputed from Space. A material file instantiates HyperelasticEffect with
 /// its kernel; the PETSc pointwise functions of the generic path come from the same kernel.
 ///
@@ -18,7 +18,7 @@
 
 #include "hypershape/core/error.hpp"
 #include "hypershape/physics/effect.hpp"
-#include "hypershape/physics/neo_hookean.hpp"
+#include "hypershape/physics/tensor.hpp"
 
 namespace hypershape::physics {
 
@@ -83,8 +83,8 @@ void g3_pointwise(PetscInt dim, PetscInt, PetscInt, const PetscInt[], const Pets
   if (dim == 2) run.template operator()<2>(); else run.template operator()<3>();
 }
 
-/// Loops over the local cells with kernel `K<D>` for the (D, NB) given at run time.
-template <template <int> class K, class Op>
+/// Runs `op.operator()<D, NB>()` for the space's dimension D and nodes per cell NB.
+template <class Op>
 bool dispatch(const Space& s, Op&& op) {
   switch (s.dim() * 10 + s.degree()) {
     case 21: return op.template operator()<2, 3>();
@@ -139,7 +139,7 @@ class HyperelasticEffect : public Effect {
   }
 
   bool add_energy(const Space& s, const PetscScalar* u, double& energy) const override {
-    return detail::dispatch<K>(s, [&]<int D, int NB>() {
+    return detail::dispatch(s, [&]<int D, int NB>() {
       const auto& k = kernel<D>();
       Eigen::Matrix<double, NB, D> ue, G;
       for (PetscInt c = s.cell_begin(); c < s.cell_end(); ++c) {
@@ -158,7 +158,7 @@ class HyperelasticEffect : public Effect {
   }
 
   bool add_residual(const Space& s, const PetscScalar* u, PetscScalar* r) const override {
-    return detail::dispatch<K>(s, [&]<int D, int NB>() {
+    return detail::dispatch(s, [&]<int D, int NB>() {
       const auto& k = kernel<D>();
       Eigen::Matrix<double, NB, D> ue, G, re;
       Tensor<D> P;
@@ -181,7 +181,7 @@ class HyperelasticEffect : public Effect {
   }
 
   bool add_jacobian(const Space& s, const PetscScalar* u, Mat J) const override {
-    return detail::dispatch<K>(s, [&]<int D, int NB>() {
+    return detail::dispatch(s, [&]<int D, int NB>() {
       constexpr int ND = NB * D;
       const auto& k = kernel<D>();
       Eigen::Matrix<double, NB, D> ue, G;

@@ -12,7 +12,7 @@
 #include <Eigen/Dense>
 #include <cmath>
 
-#include "hypershape/physics/neo_hookean.hpp"
+#include "hypershape/physics/tensor.hpp"
 
 namespace hypershape::physics {
 

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <vector>
 
-#include "hypershape/physics/neo_hookean.hpp"
+#include "hypershape/physics/tensor.hpp"
 
 namespace hypershape::physics {
 

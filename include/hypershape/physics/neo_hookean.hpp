@@ -10,21 +10,9 @@
 #include <cmath>
 #include <vector>
 
+#include "hypershape/physics/tensor.hpp"
+
 namespace hypershape::physics {
-
-template <int D>
-using Tensor = Eigen::Matrix<double, D, D>;
-/// The tangent as a (D*D) x (D*D) matrix, A(i*D + J, k*D + L) = dP_iJ / dF_kL.
-template <int D>
-using Tangent = Eigen::Matrix<double, D * D, D * D>;
-
-/// Lame parameters from Young's modulus and Poisson's ratio.
-struct Lame {
-  double mu, lambda;
-  static Lame from_young_poisson(double E, double nu) {
-    return {E / (2.0 * (1.0 + nu)), E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))};
-  }
-};
 
 template <int D>
 struct NeoHookean {

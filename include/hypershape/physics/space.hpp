@@ -62,6 +62,10 @@ class CellMatrixAdder {
   int n_ = 0;
 };
 
+namespace detail {
+struct CanonicalIds;  // space.cpp: the canonical node ids of the serial plex
+}  // namespace detail
+
 class Space {
  public:
   /// Builds the space on `dm` (distributed or not; takes ownership). `serial` and `migration`
@@ -132,6 +136,16 @@ class Space {
 
  private:
   friend class CellMatrixAdder;
+  // The constructor's steps, in order.
+  void create_fe(const SpaceOptions& opt, const std::vector<EssentialBC>& bcs, core::QuadH& q, core::QuadH& fq);
+  void tabulate_cell_rule(PetscQuadrature q);
+  void tabulate_facet_rule(PetscQuadrature fq);
+  void build_cells();
+  void cell_dofs(PetscInt c, PetscSection ls, PetscSection gs);
+  void collect_neumann_facets(const std::vector<EssentialBC>& bcs, PetscSection cs, const PetscScalar* xa);
+  void number_nodes(DM serial, PetscSF migration, PetscSection cs, const PetscScalar* xa);
+  void build_output_mesh(DM serial, const detail::CanonicalIds& canonical);
+
   /// Offsets into the CSR values of a SeqAIJ matrix of pattern (ia, ja) of every cell-matrix
   /// entry (-1: a constrained dof), rebuilt when a matrix of another pattern comes.
   const std::vector<PetscInt>& csr_offsets(const PetscInt* ia, const PetscInt* ja, PetscInt n) const;

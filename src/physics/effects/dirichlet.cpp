@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "hypershape/core/error.hpp"
+#include "hypershape/core/vec_array.hpp"
 #include "hypershape/mesh/plex.hpp"
 #include "hypershape/physics/registry.hpp"
 
@@ -34,10 +35,9 @@ class DirichletEffect : public Effect {
     HS_PETSC(DMGetLabel(serial, label_.c_str(), &label));
     Vec coords;
     PetscSection cs;
-    const PetscScalar* xa;
     HS_PETSC(DMGetCoordinatesLocal(serial, &coords));
     HS_PETSC(DMGetCoordinateSection(serial, &cs));
-    HS_PETSC(VecGetArrayRead(coords, &xa));
+    const core::VecArray<const PetscScalar> xa(coords);
     PetscInt v0, v1;
     HS_PETSC(DMPlexGetDepthStratum(serial, 0, &v0, &v1));
     IS facets = nullptr;
@@ -69,7 +69,6 @@ class DirichletEffect : public Effect {
       HS_PETSC(ISRestoreIndices(facets, &fp));
       HS_PETSC(ISDestroy(&facets));
     }
-    HS_PETSC(VecRestoreArrayRead(coords, &xa));
     MPI_Allreduce(MPI_IN_PLACE, &n_marked, 1, MPI_LONG, MPI_SUM, PetscObjectComm((PetscObject)serial));
     if (n_marked == 0)
       throw core::InputError("", name_, "selects no boundary facet of the mesh (nothing is fixed)");
