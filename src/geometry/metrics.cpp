@@ -54,155 +54,181 @@ Vec facet_normal(const Boundary& b, std::int64_t f) {
 
 // ---- shrinking ball ---------------------------------------------------------------------------
 
-/// Medial-ball radii along +/- the vertex normals; `inward` picks the side.
-std::vector<double> ball_radii(const Boundary& b, bool inward) {
-  check_dim(b, inward ? "inscribed_radii" : "exterior_radii");
-  const detail::FacetTree tree(b, {}, false);
+/// What the shrinking-ball search needs of every facet and point of a boundary.
+///
+/// Two vertex normals; which one is used depends on whether the vertex is a corner.
+///  - smooth: Max's weights (N. Max, J. Graphics Tools 4(2), 1999), the facet normal divided by
+///    the squared lengths of the facet's edges at the vertex (one edge in 2D): exact whenever the
+///    vertex and its neighbours lie on a common circle / sphere. The area-weighted normal is off
+///    by about 1 degree on an icosphere, which shrinks its balls to 0.8 R (measured): the balls
+///    are tangent to the normal, so a tilt lets the nearby samples in.
+///  - corner: unit facet normals weighted by the facet angle at the vertex (1 in 2D), the
+///    bisector whatever the lengths of the sides; Max's weights would follow the shorter side.
+struct BallFrame {
+  std::vector<Vec> smooth_normal, corner_normal;  // per point
+  std::vector<Vec> unit_normal;                   // per facet
+  std::vector<double> diameter;                   // per facet: its longest edge
+  std::vector<std::int64_t> start, incident;      // point -> facets (CSR)
+  std::vector<std::int64_t> region;               // per facet: its flat region
+
+  std::span<const std::int64_t> incident_to(std::int64_t i) const {
+    return {incident.data() + start[std::size_t(i)], incident.data() + start[std::size_t(i) + 1]};
+  }
+};
+
+/// The normals and diameter of facet f, added to its points' vertex normals.
+void add_facet(const Boundary& b, std::int64_t f, BallFrame& fr) {
   const int dim = b.dim;
-  const std::int64_t n_points = b.n_points(), n_facets = b.n_facets();
-  const double cap = tree.bbox_diagonal();
-
-  // Two vertex normals; which one is used depends on whether the vertex is a corner.
-  //  - smooth: Max's weights (N. Max, J. Graphics Tools 4(2), 1999), the facet normal divided by
-  //    the squared lengths of the facet's edges at the vertex (one edge in 2D): exact whenever the
-  //    vertex and its neighbours lie on a common circle / sphere. The area-weighted normal is off
-  //    by about 1 degree on an icosphere, which shrinks its balls to 0.8 R (measured): the balls
-  //    are tangent to the normal, so a tilt lets the nearby samples in.
-  //  - corner: unit facet normals weighted by the facet angle at the vertex (1 in 2D), the
-  //    bisector whatever the lengths of the sides; Max's weights would follow the shorter side.
-  std::vector<Vec> smooth_normal(std::size_t(n_points), Vec{0, 0, 0});
-  std::vector<Vec> corner_normal(std::size_t(n_points), Vec{0, 0, 0});
-  std::vector<Vec> unit_normal(static_cast<std::size_t>(n_facets));
-  std::vector<double> diameter(std::size_t(n_facets), 0.0);
-  std::vector<std::int64_t> start(std::size_t(n_points) + 1, 0), incident;  // point -> facets
-  for (std::int64_t f = 0; f < n_facets; ++f) {
-    const Vec n = facet_normal(b, f);
-    const double len = std::sqrt(norm2(n));
-    const Vec u = len > 0 ? Vec{n[0] / len, n[1] / len, n[2] / len} : Vec{0, 0, 0};
-    unit_normal[std::size_t(f)] = u;
-    const auto v = b.facet(f);
-    for (int i = 0; i < dim; ++i) {
-      const auto vi = std::size_t(v[std::size_t(i)]);
-      const Vec x = point3(b, std::int64_t(vi));
-      ++start[vi + 1];
-      const Vec e1 = sub(point3(b, v[std::size_t((i + 1) % dim)]), x);
-      const Vec e2 = dim == 3 ? sub(point3(b, v[std::size_t((i + 2) % dim)]), x) : e1;
-      const double weight = dim == 3 ? norm2(e1) * norm2(e2) : norm2(e1);
-      const double angle =
-          dim == 3 ? std::atan2(std::sqrt(norm2(cross(e1, e2))), dot(e1, e2)) : 1.0;
-      for (int k = 0; k < 3; ++k) {
-        if (weight > 0) smooth_normal[vi][std::size_t(k)] += n[std::size_t(k)] / weight;
-        corner_normal[vi][std::size_t(k)] += angle * u[std::size_t(k)];
-      }
-      for (int j = i + 1; j < dim; ++j)
-        diameter[std::size_t(f)] =
-            std::max(diameter[std::size_t(f)], norm2(sub(x, point3(b, v[std::size_t(j)]))));
+  const Vec n = facet_normal(b, f);
+  const double len = std::sqrt(norm2(n));
+  const Vec u = len > 0 ? Vec{n[0] / len, n[1] / len, n[2] / len} : Vec{0, 0, 0};
+  fr.unit_normal[std::size_t(f)] = u;
+  const auto v = b.facet(f);
+  double& diameter = fr.diameter[std::size_t(f)];
+  for (int i = 0; i < dim; ++i) {
+    const auto vi = std::size_t(v[std::size_t(i)]);
+    const Vec x = point3(b, std::int64_t(vi));
+    ++fr.start[vi + 1];
+    const Vec e1 = sub(point3(b, v[std::size_t((i + 1) % dim)]), x);
+    const Vec e2 = dim == 3 ? sub(point3(b, v[std::size_t((i + 2) % dim)]), x) : e1;
+    const double weight = dim == 3 ? norm2(e1) * norm2(e2) : norm2(e1);
+    const double angle = dim == 3 ? std::atan2(std::sqrt(norm2(cross(e1, e2))), dot(e1, e2)) : 1.0;
+    for (int k = 0; k < 3; ++k) {
+      if (weight > 0) fr.smooth_normal[vi][std::size_t(k)] += n[std::size_t(k)] / weight;
+      fr.corner_normal[vi][std::size_t(k)] += angle * u[std::size_t(k)];
     }
-    diameter[std::size_t(f)] = std::sqrt(diameter[std::size_t(f)]);
+    for (int j = i + 1; j < dim; ++j) diameter = std::max(diameter, norm2(sub(x, point3(b, v[std::size_t(j)]))));
   }
-  for (std::int64_t i = 0; i < n_points; ++i) start[std::size_t(i) + 1] += start[std::size_t(i)];
-  incident.resize(std::size_t(start.back()));
-  {
-    std::vector<std::int64_t> fill(start.begin(), start.end() - 1);
-    for (std::int64_t f = 0; f < n_facets; ++f)
-      for (const int v : b.facet(f)) incident[std::size_t(fill[std::size_t(v)]++)] = f;
-  }
-  const auto incident_to = [&](std::int64_t i) {
-    return std::span<const std::int64_t>(incident.data() + start[std::size_t(i)],
-                                         incident.data() + start[std::size_t(i) + 1]);
-  };
+  diameter = std::sqrt(diameter);
+}
 
-  // Flat regions: maximal sets of facets, connected through shared vertices (2D) / edges (3D),
-  // with the same normal (the straight side of a polygon, the face of a box). The regions of the
-  // facets at p are ignored, not only those facets: where the boundary is smooth at p they are
-  // tangent to every candidate ball anyway, and at a convex corner (where the exact medial ball
-  // is 0) the ball then grows along the bisector until it meets the rest of the shape, the same
-  // for any sampling of the sides.
-  std::vector<std::int64_t> region(static_cast<std::size_t>(n_facets));
-  for (std::int64_t f = 0; f < n_facets; ++f) region[std::size_t(f)] = f;
+/// Flat regions: maximal sets of facets, connected through shared vertices (2D) / edges (3D),
+/// with the same normal (the straight side of a polygon, the face of a box). The regions of the
+/// facets at p are ignored, not only those facets: where the boundary is smooth at p they are
+/// tangent to every candidate ball anyway, and at a convex corner (where the exact medial ball
+/// is 0) the ball then grows along the bisector until it meets the rest of the shape, the same
+/// for any sampling of the sides.
+std::vector<std::int64_t> flat_regions(const Boundary& b, const BallFrame& fr) {
+  const int dim = b.dim;
+  std::vector<std::int64_t> region(std::size_t(b.n_facets()));
+  for (std::int64_t f = 0; f < b.n_facets(); ++f) region[std::size_t(f)] = f;
   const auto find = [&](std::int64_t f) {
-    while (region[std::size_t(f)] != f)
-      f = region[std::size_t(f)] = region[std::size_t(region[std::size_t(f)])];
+    while (region[std::size_t(f)] != f) f = region[std::size_t(f)] = region[std::size_t(region[std::size_t(f)])];
     return f;
   };
-  for (std::int64_t f = 0; f < n_facets; ++f) {
+  for (std::int64_t f = 0; f < b.n_facets(); ++f) {
     const auto v = b.facet(f);
     for (int i = 0; i < dim; ++i) {
       const int a = v[std::size_t(i)], c = v[std::size_t((i + 1) % dim)];
-      for (const std::int64_t g : incident_to(a)) {
+      for (const std::int64_t g : fr.incident_to(a)) {
         if (g <= f) continue;
         const auto w = b.facet(g);
         if (dim == 3 && std::find(w.begin(), w.end(), c) == w.end()) continue;  // no shared edge
-        if (dot(unit_normal[std::size_t(f)], unit_normal[std::size_t(g)]) < 1 - 1e-12) continue;
+        if (dot(fr.unit_normal[std::size_t(f)], fr.unit_normal[std::size_t(g)]) < 1 - 1e-12) continue;
         region[std::size_t(find(f))] = find(g);
       }
     }
   }
-  for (std::int64_t f = 0; f < n_facets; ++f) region[std::size_t(f)] = find(f);
+  for (std::int64_t f = 0; f < b.n_facets(); ++f) region[std::size_t(f)] = find(f);
+  return region;
+}
 
-  // A facet whose vertices are all outside (or on) the ball and that is short compared to the
-  // radius cuts into the ball by at most its sagitta: r (1 - sqrt(1 - beta^2 / 4)) <= r / 32 for
-  // beta = 1/2. That is how a sampled circle or sphere looks from its centre (an icosphere with
-  // 320 triangles has facets of 0.35 R), so it does not shrink the ball. A longer facet does:
-  // then the polygon/surface itself is the shape.
-  constexpr double beta = 0.5;
-  constexpr double rel_tol = 1e-9;  // contacts within this relative depth count as touching
+BallFrame ball_frame(const Boundary& b) {
+  const std::int64_t n_points = b.n_points(), n_facets = b.n_facets();
+  BallFrame fr;
+  fr.smooth_normal.assign(std::size_t(n_points), Vec{0, 0, 0});
+  fr.corner_normal.assign(std::size_t(n_points), Vec{0, 0, 0});
+  fr.unit_normal.resize(std::size_t(n_facets));
+  fr.diameter.assign(std::size_t(n_facets), 0.0);
+  fr.start.assign(std::size_t(n_points) + 1, 0);
+  for (std::int64_t f = 0; f < n_facets; ++f) add_facet(b, f, fr);
+  for (std::int64_t i = 0; i < n_points; ++i) fr.start[std::size_t(i) + 1] += fr.start[std::size_t(i)];
+  fr.incident.resize(std::size_t(fr.start.back()));
+  std::vector<std::int64_t> fill(fr.start.begin(), fr.start.end() - 1);
+  for (std::int64_t f = 0; f < n_facets; ++f)
+    for (const int v : b.facet(f)) fr.incident[std::size_t(fill[std::size_t(v)]++)] = f;
+  fr.region = flat_regions(b, fr);
+  return fr;
+}
 
-  std::vector<double> radii(std::size_t(n_points), std::numeric_limits<double>::quiet_NaN());
-  std::vector<std::int64_t> own_regions;
-  for (std::int64_t i = 0; i < n_points; ++i) {
-    // A corner: two facets at p whose normals differ by more than 30 degrees.
-    bool corner = false;
-    const auto at_p = incident_to(i);
-    for (std::size_t a = 0; a < at_p.size() && !corner; ++a)
-      for (std::size_t c = a + 1; c < at_p.size() && !corner; ++c)
-        corner = dot(unit_normal[std::size_t(at_p[a])], unit_normal[std::size_t(at_p[c])]) <
-                 std::cos(std::numbers::pi / 6);
-    Vec n = corner ? corner_normal[std::size_t(i)] : smooth_normal[std::size_t(i)];
-    const double len = std::sqrt(norm2(n));
-    if (!(len > 0)) continue;  // on no facet (or a degenerate fan)
-    const double s = (inward ? -1.0 : 1.0) / len;
-    for (double& component : n) component *= s;
-    const Vec p = point3(b, i);
-    std::vector<std::int64_t>& own = own_regions;
-    own.clear();
-    for (const std::int64_t f : incident_to(i)) own.push_back(region[std::size_t(f)]);
+/// The unit normal at point i pointing into the ball's side (zero if the point is on no facet):
+/// at a corner (two facets at it whose normals differ by more than 30 degrees) the bisector.
+Vec ball_direction(const BallFrame& fr, std::int64_t i, bool inward) {
+  bool corner = false;
+  const auto at_p = fr.incident_to(i);
+  for (std::size_t a = 0; a < at_p.size() && !corner; ++a)
+    for (std::size_t c = a + 1; c < at_p.size() && !corner; ++c)
+      corner = dot(fr.unit_normal[std::size_t(at_p[a])], fr.unit_normal[std::size_t(at_p[c])]) <
+               std::cos(std::numbers::pi / 6);
+  Vec n = corner ? fr.corner_normal[std::size_t(i)] : fr.smooth_normal[std::size_t(i)];
+  const double len = std::sqrt(norm2(n));
+  if (!(len > 0)) return {0, 0, 0};  // on no facet (or a degenerate fan)
+  const double s = (inward ? -1.0 : 1.0) / len;
+  for (double& component : n) component *= s;
+  return n;
+}
 
-    double r = cap;
-    for (int iter = 0; iter < 100 && r > 0; ++iter) {
-      const Vec c = {p[0] + r * n[0], p[1] + r * n[1], p[2] + r * n[2]};
-      const double inner2 = (r * (1 - rel_tol)) * (r * (1 - rel_tol));
-      const auto skip = [&](std::int64_t f) {
-        if (std::find(own.begin(), own.end(), region[std::size_t(f)]) != own.end()) return true;
-        if (diameter[std::size_t(f)] > beta * r) return false;
-        for (const int w : b.facet(f))
-          if (norm2(sub(point3(b, w), c)) < inner2) return false;
-        return true;
-      };
-      const detail::ClosestHit hit = tree.closest_if(c.data(), inner2, skip);
-      if (hit.facet < 0) break;  // the ball is empty: done
-      // A short facet stands for its vertices, the samples of the shape: the ball shrinks to
-      // exclude the vertex that is inside it, not the chord (which lies inside the sampled
-      // surface by its sagitta, and would make the ball at a point of high curvature too small).
-      Vec q = hit.point;
-      if (diameter[std::size_t(hit.facet)] <= beta * r) {
-        double best = HUGE_VAL;
-        for (const int w : b.facet(hit.facet)) {
-          const Vec x = point3(b, w);
-          if (const double d2 = norm2(sub(x, c)); d2 < best) best = d2, q = x;
-        }
+// A facet whose vertices are all outside (or on) the ball and that is short compared to the
+// radius cuts into the ball by at most its sagitta: r (1 - sqrt(1 - beta^2 / 4)) <= r / 32 for
+// beta = 1/2. That is how a sampled circle or sphere looks from its centre (an icosphere with
+// 320 triangles has facets of 0.35 R), so it does not shrink the ball. A longer facet does:
+// then the polygon/surface itself is the shape.
+constexpr double beta = 0.5;
+constexpr double rel_tol = 1e-9;  // contacts within this relative depth count as touching
+
+/// The ball at point i along n, shrunk from radius `cap` until it holds no sample of the shape.
+double shrink_ball(const Boundary& b, const detail::FacetTree& tree, const BallFrame& fr, std::int64_t i, const Vec& n,
+                   double cap) {
+  const Vec p = point3(b, i);
+  std::vector<std::int64_t> own;
+  for (const std::int64_t f : fr.incident_to(i)) own.push_back(fr.region[std::size_t(f)]);
+  double r = cap;
+  for (int iter = 0; iter < 100 && r > 0; ++iter) {
+    const Vec c = {p[0] + r * n[0], p[1] + r * n[1], p[2] + r * n[2]};
+    const double inner2 = (r * (1 - rel_tol)) * (r * (1 - rel_tol));
+    const auto skip = [&](std::int64_t f) {
+      if (std::find(own.begin(), own.end(), fr.region[std::size_t(f)]) != own.end()) return true;
+      if (fr.diameter[std::size_t(f)] > beta * r) return false;
+      for (const int w : b.facet(f))
+        if (norm2(sub(point3(b, w), c)) < inner2) return false;
+      return true;
+    };
+    const detail::ClosestHit hit = tree.closest_if(c.data(), inner2, skip);
+    if (hit.facet < 0) break;  // the ball is empty: done
+    // A short facet stands for its vertices, the samples of the shape: the ball shrinks to
+    // exclude the vertex that is inside it, not the chord (which lies inside the sampled
+    // surface by its sagitta, and would make the ball at a point of high curvature too small).
+    Vec q = hit.point;
+    if (fr.diameter[std::size_t(hit.facet)] <= beta * r) {
+      double best = HUGE_VAL;
+      for (const int w : b.facet(hit.facet)) {
+        const Vec x = point3(b, w);
+        if (const double d2 = norm2(sub(x, c)); d2 < best) best = d2, q = x;
       }
-      const Vec pq = sub(q, p);
-      const double denom = 2 * dot(n, pq);
-      // |c - q| < r implies n.(q - p) > |q - p|^2 / (2 r) > 0; a non-positive value is round-off
-      // for q at p: the boundary touches itself there.
-      const double r_new = denom > 0 ? norm2(pq) / denom : 0.0;
-      if (!(r_new < r)) break;
-      const bool converged = r - r_new <= 1e-12 * r;
-      r = r_new;
-      if (converged) break;
     }
-    radii[std::size_t(i)] = r;
+    const Vec pq = sub(q, p);
+    const double denom = 2 * dot(n, pq);
+    // |c - q| < r implies n.(q - p) > |q - p|^2 / (2 r) > 0; a non-positive value is round-off
+    // for q at p: the boundary touches itself there.
+    const double r_new = denom > 0 ? norm2(pq) / denom : 0.0;
+    if (!(r_new < r)) break;
+    const bool converged = r - r_new <= 1e-12 * r;
+    r = r_new;
+    if (converged) break;
+  }
+  return r;
+}
+
+/// Medial-ball radii along +/- the vertex normals; `inward` picks the side (NaN for a point on
+/// no facet).
+std::vector<double> ball_radii(const Boundary& b, bool inward) {
+  check_dim(b, inward ? "inscribed_radii" : "exterior_radii");
+  const detail::FacetTree tree(b, {}, false);
+  const BallFrame fr = ball_frame(b);
+  std::vector<double> radii(std::size_t(b.n_points()), std::numeric_limits<double>::quiet_NaN());
+  for (std::int64_t i = 0; i < b.n_points(); ++i) {
+    const Vec n = ball_direction(fr, i, inward);
+    if (n[0] != 0 || n[1] != 0 || n[2] != 0) radii[std::size_t(i)] = shrink_ball(b, tree, fr, i, n, tree.bbox_diagonal());
   }
   return radii;
 }
