@@ -356,138 +356,163 @@ std::uint64_t edge_key(int a, int b) {
 
 }  // namespace
 
-SurfaceSamples sample_surface_image(RandomDeformation& phi, const Boundary& base, BaseKind kind,
-                                    double spacing, std::int64_t max_points) {
-  assert(phi.dim() == 3 && base.dim == 3);
-  const double flowed_spacing = spacing / phi.scale();
-  std::vector<double> pre(base.points.begin(), base.points.end());
-  std::vector<double> img(pre);
-  std::vector<int> tri(base.facets.begin(), base.facets.end());
-  for (std::size_t i = 0; i < img.size(); i += 3) phi.flow(&img[i]);
+namespace {
 
-  std::unordered_map<std::uint64_t, std::array<int, 2>> edge_tris;
-  edge_tris.reserve(2 * tri.size());
-  auto add_edge_tri = [&](int a, int b, int t) {
-    auto [it, inserted] = edge_tris.try_emplace(edge_key(a, b), std::array<int, 2>{t, -1});
-    if (!inserted) {
-      if (it->second[1] >= 0) throw std::runtime_error("base surface is not a 2-manifold");
-      it->second[1] = t;
-    }
-  };
-  auto replace_edge_tri = [&](int a, int b, int old_t, int new_t) {
-    auto& e = edge_tris.at(edge_key(a, b));
+/// Longest-edge propagation path bisection (Rivara) of a closed triangle surface, driven by its
+/// image under a flow: every triangle whose image edges are longer than the spacing is refined.
+/// A triangle is refined by bisecting the terminal edge of its LEPP, the first edge on the path
+/// that is the longest edge of both of its triangles, until it is resolved. Bisecting only
+/// longest pre-image edges keeps the pre-image triangles shape-regular (angles bounded below by
+/// half the smallest angle of the base), so their diameters shrink geometrically and the
+/// refinement ends wherever phi is continuous. (Bisecting the longest IMAGE edge instead does not
+/// end where the image folds back on itself closer than `spacing`: the points then pile up on a
+/// pre-image edge whose image is short.)
+class LeppRefiner {
+ public:
+  LeppRefiner(RandomDeformation& phi, const Boundary& base, BaseKind kind, double flowed_spacing,
+              std::int64_t max_points)
+      : phi_(phi), kind_(kind), limit2_(flowed_spacing * flowed_spacing), max_points_(max_points),
+        pre_(base.points.begin(), base.points.end()), img_(pre_), tri_(base.facets.begin(), base.facets.end()) {
+    for (std::size_t i = 0; i < img_.size(); i += 3) phi_.flow(&img_[i]);
+    edge_tris_.reserve(2 * tri_.size());
+    const int n_tri0 = int(tri_.size() / 3);
+    for (int t = 0; t < n_tri0; ++t)
+      for (int q = 0; q < 3; ++q) add_edge_tri(tri_[3 * t + q], tri_[3 * t + (q + 1) % 3], t);
+    for (const auto& [key, tris] : edge_tris_)
+      if (tris[1] < 0) throw std::runtime_error("base surface is not closed");
+    for (int t = 0; t < n_tri0; ++t)
+      if (unresolved(t)) queue_.push_back(t);
+  }
+
+  /// Refines until every triangle is resolved (first in, first out).
+  void refine() {
+    for (std::size_t head = 0; head < queue_.size(); ++head)
+      while (unresolved(queue_[head])) bisect_terminal_edge(queue_[head]);
+  }
+
+  std::vector<double>& preimage() { return pre_; }
+  const std::vector<double>& image() const { return img_; }
+  std::vector<int>& triangles() { return tri_; }
+
+ private:
+  void add_edge_tri(int a, int b, int t) {
+    auto [it, inserted] = edge_tris_.try_emplace(edge_key(a, b), std::array<int, 2>{t, -1});
+    if (inserted) return;
+    if (it->second[1] >= 0) throw std::runtime_error("base surface is not a 2-manifold");
+    it->second[1] = t;
+  }
+  void replace_edge_tri(int a, int b, int old_t, int new_t) {
+    auto& e = edge_tris_.at(edge_key(a, b));
     (e[0] == old_t ? e[0] : e[1]) = new_t;
-  };
-  const int n_tri0 = int(tri.size() / 3);
-  for (int t = 0; t < n_tri0; ++t)
-    for (int q = 0; q < 3; ++q) add_edge_tri(tri[3 * t + q], tri[3 * t + (q + 1) % 3], t);
-  for (const auto& [key, tris] : edge_tris)
-    if (tris[1] < 0) throw std::runtime_error("base surface is not closed");
-
-  auto dist2 = [](const std::vector<double>& x, int a, int b) {
+  }
+  static double dist2(const std::vector<double>& x, int a, int b) {
     const double* p = &x[3 * std::size_t(a)];
     const double* q = &x[3 * std::size_t(b)];
     return (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]);
-  };
-  const double limit2 = flowed_spacing * flowed_spacing;
-  // A triangle is resolved when its image edges are no longer than the spacing.
-  auto unresolved = [&](int t) {
-    const int* v = &tri[3 * std::size_t(t)];
-    return dist2(img, v[0], v[1]) > limit2 || dist2(img, v[1], v[2]) > limit2 ||
-           dist2(img, v[2], v[0]) > limit2;
-  };
-  // The longest edge of a triangle in the PRE-IMAGE (ties broken by vertex ids, so that "the
-  // longest edge" is a strict total order): returns the position q of edge (v[q], v[q+1]).
-  auto longest = [&](int t) {
-    const int* v = &tri[3 * std::size_t(t)];
+  }
+  /// A triangle is resolved when its image edges are no longer than the spacing.
+  bool unresolved(int t) const {
+    const int* v = &tri_[3 * std::size_t(t)];
+    return dist2(img_, v[0], v[1]) > limit2_ || dist2(img_, v[1], v[2]) > limit2_ || dist2(img_, v[2], v[0]) > limit2_;
+  }
+  /// The longest edge of a triangle in the PRE-IMAGE (ties broken by vertex ids, so that "the
+  /// longest edge" is a strict total order): the position q of edge (v[q], v[q+1]).
+  int longest(int t) const {
+    const int* v = &tri_[3 * std::size_t(t)];
     int best = 0;
     double best_len = -1.0;
     std::uint64_t best_key = 0;
     for (int q = 0; q < 3; ++q) {
-      const double l = dist2(pre, v[q], v[(q + 1) % 3]);
+      const double l = dist2(pre_, v[q], v[(q + 1) % 3]);
       const std::uint64_t k = edge_key(v[q], v[(q + 1) % 3]);
       if (l > best_len || (l == best_len && k > best_key)) best = q, best_len = l, best_key = k;
     }
     return best;
-  };
-  // Position of the directed edge a->b inside triangle t, or -1.
-  auto directed = [&](int t, int a, int b) {
+  }
+  /// Position of the directed edge a->b inside triangle t, or -1.
+  int directed(int t, int a, int b) const {
     for (int q = 0; q < 3; ++q)
-      if (tri[3 * t + q] == a && tri[3 * t + (q + 1) % 3] == b) return q;
+      if (tri_[3 * t + q] == a && tri_[3 * t + (q + 1) % 3] == b) return q;
     return -1;
-  };
-  std::vector<int> queue;  // triangles to look at, first in first out
-  for (int t = 0; t < n_tri0; ++t)
-    if (unresolved(t)) queue.push_back(t);
-  // Splits edge (a, b) at the midpoint of its pre-image (projected per `kind`) and both of its
-  // triangles in two; queues the four triangles.
-  auto bisect = [&](int a, int b) {
-    if (std::int64_t(pre.size() / 3) >= max_points)
-      throw std::runtime_error(
-          "surface needs too many points to resolve (more than " + std::to_string(max_points) + ")");
-    const auto tris = edge_tris.at(edge_key(a, b));
+  }
+  /// Walks the longest-edge path from t and bisects its terminal edge.
+  void bisect_terminal_edge(int t) {
+    for (int cur = t;;) {
+      const int q = longest(cur);
+      const int a = tri_[3 * cur + q], b = tri_[3 * cur + (q + 1) % 3];
+      const auto& tris = edge_tris_.at(edge_key(a, b));
+      const int other = tris[0] == cur ? tris[1] : tris[0];
+      const int qo = longest(other);
+      if (edge_key(tri_[3 * other + qo], tri_[3 * other + (qo + 1) % 3]) == edge_key(a, b)) return bisect(a, b);
+      cur = other;
+    }
+  }
+  /// The midpoint of the pre-image edge (a, b), projected per `kind`, appended with its image.
+  int add_midpoint(int a, int b) {
+    if (std::int64_t(pre_.size() / 3) >= max_points_)
+      throw std::runtime_error("surface needs too many points to resolve (more than " + std::to_string(max_points_) +
+                               ")");
+    double p[3];
+    for (int k = 0; k < 3; ++k) p[k] = 0.5 * (pre_[3 * std::size_t(a) + k] + pre_[3 * std::size_t(b) + k]);
+    if (kind_ == BaseKind::sphere) {
+      const double r = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+      for (double& v : p) v /= r;
+    }
+    pre_.insert(pre_.end(), p, p + 3);
+    phi_.flow(p);
+    img_.insert(img_.end(), p, p + 3);
+    return int(pre_.size() / 3) - 1;
+  }
+  /// Splits edge (a, b) at its midpoint and both of its triangles in two; queues the four.
+  void bisect(int a, int b) {
+    const auto tris = edge_tris_.at(edge_key(a, b));
     int t1 = tris[0], t2 = tris[1];
     if (directed(t1, a, b) < 0) std::swap(t1, t2);  // t1 holds a->b, t2 holds b->a
     const int q1 = directed(t1, a, b), q2 = directed(t2, b, a);
     if (q1 < 0 || q2 < 0) throw std::runtime_error("base surface is not consistently oriented");
-    const int c = tri[3 * t1 + (q1 + 2) % 3];
-    const int d = tri[3 * t2 + (q2 + 2) % 3];
-    const int m = int(pre.size() / 3);
-    double p[3];
-    for (int k = 0; k < 3; ++k) p[k] = 0.5 * (pre[3 * std::size_t(a) + k] + pre[3 * std::size_t(b) + k]);
-    if (kind == BaseKind::sphere) {
-      const double r = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
-      for (double& v : p) v /= r;
-    }
-    pre.insert(pre.end(), p, p + 3);
-    phi.flow(p);
-    img.insert(img.end(), p, p + 3);
+    const int c = tri_[3 * t1 + (q1 + 2) % 3];
+    const int d = tri_[3 * t2 + (q2 + 2) % 3];
+    const int m = add_midpoint(a, b);
     // t1 = (a, b, c) -> (a, m, c) and new t3 = (m, b, c);
     // t2 = (b, a, d) -> (b, m, d) and new t4 = (m, a, d).
-    const int t3 = int(tri.size() / 3), t4 = t3 + 1;
-    tri[3 * t1 + 0] = a, tri[3 * t1 + 1] = m, tri[3 * t1 + 2] = c;
-    tri[3 * t2 + 0] = b, tri[3 * t2 + 1] = m, tri[3 * t2 + 2] = d;
-    tri.insert(tri.end(), {m, b, c, m, a, d});
-    edge_tris.erase(edge_key(a, b));
+    const int t3 = int(tri_.size() / 3), t4 = t3 + 1;
+    tri_[3 * t1 + 0] = a, tri_[3 * t1 + 1] = m, tri_[3 * t1 + 2] = c;
+    tri_[3 * t2 + 0] = b, tri_[3 * t2 + 1] = m, tri_[3 * t2 + 2] = d;
+    tri_.insert(tri_.end(), {m, b, c, m, a, d});
+    edge_tris_.erase(edge_key(a, b));
     replace_edge_tri(b, c, t1, t3);
     replace_edge_tri(a, d, t2, t4);
-    edge_tris[edge_key(a, m)] = {t1, t4};
-    edge_tris[edge_key(m, b)] = {t3, t2};
-    edge_tris[edge_key(m, c)] = {t1, t3};
-    edge_tris[edge_key(m, d)] = {t2, t4};
-    queue.insert(queue.end(), {t1, t2, t3, t4});
-  };
-  // Longest-edge propagation path bisection (Rivara): a triangle is refined by bisecting the
-  // terminal edge of its LEPP, the first edge on the path that is the longest edge of both of its
-  // triangles, until it is resolved. Bisecting only longest pre-image edges keeps the pre-image
-  // triangles shape-regular (angles bounded below by half the smallest angle of the base), so
-  // their diameters shrink geometrically and the refinement ends wherever phi is continuous.
-  // (Bisecting the longest IMAGE edge instead does not end where the image folds back on itself
-  // closer than `spacing`: the points then pile up on a pre-image edge whose image is short.)
-  for (std::size_t head = 0; head < queue.size(); ++head) {
-    const int t = queue[head];
-    while (unresolved(t)) {
-      int cur = t;
-      for (;;) {
-        const int q = longest(cur);
-        const int a = tri[3 * cur + q], b = tri[3 * cur + (q + 1) % 3];
-        const auto& tris = edge_tris.at(edge_key(a, b));
-        const int other = tris[0] == cur ? tris[1] : tris[0];
-        const int qo = longest(other);
-        if (edge_key(tri[3 * other + qo], tri[3 * other + (qo + 1) % 3]) == edge_key(a, b)) {
-          bisect(a, b);
-          break;
-        }
-        cur = other;
-      }
-    }
+    edge_tris_[edge_key(a, m)] = {t1, t4};
+    edge_tris_[edge_key(m, b)] = {t3, t2};
+    edge_tris_[edge_key(m, c)] = {t1, t3};
+    edge_tris_[edge_key(m, d)] = {t2, t4};
+    queue_.insert(queue_.end(), {t1, t2, t3, t4});
   }
+
+  RandomDeformation& phi_;
+  BaseKind kind_;
+  double limit2_;
+  std::int64_t max_points_;
+  std::vector<double> pre_, img_;
+  std::vector<int> tri_;
+  std::unordered_map<std::uint64_t, std::array<int, 2>> edge_tris_;
+  std::vector<int> queue_;  // triangles to look at, first in first out
+};
+
+}  // namespace
+
+SurfaceSamples sample_surface_image(RandomDeformation& phi, const Boundary& base, BaseKind kind,
+                                    double spacing, std::int64_t max_points) {
+  assert(phi.dim() == 3 && base.dim == 3);
+  LeppRefiner lepp(phi, base, kind, spacing / phi.scale(), max_points);
+  lepp.refine();
   double lo[3], hi[3];
-  bounding_box(3, img, lo, hi);
+  bounding_box(3, lepp.image(), lo, hi);
   phi.normalise_box(lo, hi);
   SurfaceSamples out;
   out.surface.dim = 3;
-  out.surface.facets = std::move(tri);
+  out.surface.facets = std::move(lepp.triangles());
+  std::vector<double>& pre = lepp.preimage();
   out.surface.points.resize(pre.size());
   for (std::size_t i = 0; i < pre.size(); i += 3) {
     double x[3] = {pre[i], pre[i + 1], pre[i + 2]};
