@@ -99,16 +99,10 @@ std::vector<std::string> surface_files_in(const std::string& dir) {
   return paths;
 }
 
-geometry::Boundary read_surface_file(const std::string& path) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec))
-    bad_file(path, "surface file does not exist or is not a regular file");
-  const std::string ext = lower_extension(path);
-  if (!is_surface_extension(ext))
-    bad_file(path, "unsupported surface file extension '" + ext + "' (.stl or .msh expected)");
+namespace {
 
-  detail::ScopedModel model("surface_file");
+/// Loads `path` into the current gmsh model; an unreadable file is an input error naming it.
+void merge_into_gmsh(const std::string& path) {
   gmsh::option::setNumber("General.Terminal", 0);
   // gmsh keeps its last error across calls: only a new one speaks about this file.
   const std::string error_before = detail::last_gmsh_error();
@@ -118,27 +112,32 @@ geometry::Boundary read_surface_file(const std::string& path) {
     detail::restart_gmsh();
     bad_file(path, "gmsh could not read the file: " + s);
   }
-  if (auto err = detail::last_gmsh_error();
-      err != error_before && err.find("rror") != std::string::npos) {
+  if (auto err = detail::last_gmsh_error(); err != error_before && err.find("rror") != std::string::npos) {
     detail::restart_gmsh();
     bad_file(path, "gmsh could not read the file: " + err);
   }
+}
 
+/// The model's nodes and its triangles' corner nodes (3- and 6-node triangles); quadrangles refused.
+struct GmshTriangles {
   std::vector<std::size_t> node_tags, tri_nodes;
   std::vector<double> xyz;
+};
+
+GmshTriangles read_triangles(const std::string& path) {
+  GmshTriangles t;
   std::size_t n_quads = 0;
   try {
     std::vector<double> param;
-    gmsh::model::mesh::getNodes(node_tags, xyz, param, -1, -1, false, false);
+    gmsh::model::mesh::getNodes(t.node_tags, t.xyz, param, -1, -1, false, false);
     // gmsh 4.8 leaves the output vectors as they were when there is no element of the type.
     std::vector<std::size_t> tags, nodes;
-    gmsh::model::mesh::getElementsByType(2, tags, tri_nodes, -1);  // 3-node triangles
+    gmsh::model::mesh::getElementsByType(2, tags, t.tri_nodes, -1);  // 3-node triangles
     tags.clear();
     nodes.clear();
     gmsh::model::mesh::getElementsByType(9, tags, nodes, -1);  // 6-node: keep the corners
     for (std::size_t e = 0; e + 6 <= nodes.size(); e += 6)
-      tri_nodes.insert(tri_nodes.end(), nodes.begin() + std::ptrdiff_t(e),
-                       nodes.begin() + std::ptrdiff_t(e + 3));
+      t.tri_nodes.insert(t.tri_nodes.end(), nodes.begin() + std::ptrdiff_t(e), nodes.begin() + std::ptrdiff_t(e + 3));
     for (int quad_type : {3, 10, 16}) {  // 4-, 9- and 8-node quadrangles
       tags.clear();
       nodes.clear();
@@ -150,20 +149,24 @@ geometry::Boundary read_surface_file(const std::string& path) {
     bad_file(path, "gmsh could not read the mesh in the file: " + s);
   }
   if (n_quads > 0)
-    bad_file(path, "the file holds " + std::to_string(n_quads) +
-                       " quadrangles; only triangles are allowed");
-  if (tri_nodes.empty()) bad_file(path, "the file holds no triangles");
+    bad_file(path, "the file holds " + std::to_string(n_quads) + " quadrangles; only triangles are allowed");
+  if (t.tri_nodes.empty()) bad_file(path, "the file holds no triangles");
+  return t;
+}
 
+/// The triangles as a boundary: every referenced node present and finite, coincident points
+/// welded (STL stores each triangle's corners separately), points numbered in order of first
+/// use (which drops nodes that no triangle uses).
+geometry::Boundary weld(const std::string& path, const GmshTriangles& t) {
   std::unordered_map<std::size_t, std::size_t> node_pos;
-  node_pos.reserve(node_tags.size());
-  for (std::size_t i = 0; i < node_tags.size(); ++i) node_pos[node_tags[i]] = i;
+  node_pos.reserve(t.node_tags.size());
+  for (std::size_t i = 0; i < t.node_tags.size(); ++i) node_pos[t.node_tags[i]] = i;
   double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
-  for (std::size_t tag : tri_nodes) {
+  for (std::size_t tag : t.tri_nodes) {
     auto it = node_pos.find(tag);
-    if (it == node_pos.end())
-      bad_file(path, "a triangle refers to node " + std::to_string(tag) + ", which is missing");
+    if (it == node_pos.end()) bad_file(path, "a triangle refers to node " + std::to_string(tag) + ", which is missing");
     for (int k = 0; k < 3; ++k) {
-      const double x = xyz[3 * it->second + k];
+      const double x = t.xyz[3 * it->second + k];
       if (!std::isfinite(x)) bad_file(path, "node " + std::to_string(tag) + " is not finite");
       lo[k] = std::min(lo[k], x);
       hi[k] = std::max(hi[k], x);
@@ -171,33 +174,45 @@ geometry::Boundary read_surface_file(const std::string& path) {
   }
   const double diag = std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
   if (!(diag > 0)) bad_file(path, "all the triangles' points coincide");
-
-  // Weld coincident points (STL stores each triangle's corners separately) and number the points
-  // in order of first use, which also drops nodes that no triangle uses.
   Welder welder(1e-9 * diag);
   geometry::Boundary b;
   b.dim = 3;
-  b.facets.reserve(tri_nodes.size());
-  for (std::size_t tag : tri_nodes) {
+  b.facets.reserve(t.tri_nodes.size());
+  for (std::size_t tag : t.tri_nodes) {
     const std::size_t p = node_pos[tag];
-    b.facets.push_back(welder.find_or_add({xyz[3 * p], xyz[3 * p + 1], xyz[3 * p + 2]}));
+    b.facets.push_back(welder.find_or_add({t.xyz[3 * p], t.xyz[3 * p + 1], t.xyz[3 * p + 2]}));
   }
   b.points = std::move(welder.points());
+  return b;
+}
 
-  // Outward: flip everything if the enclosed volume is negative (only meaningful when the
-  // orientation is consistent, which check_boundary then verifies).
+/// Outward: flips every triangle if the enclosed volume is negative (only meaningful when the
+/// orientation is consistent, which check_boundary then verifies).
+void orient_outward(geometry::Boundary& b) {
   double vol6 = 0;
   for (std::int64_t f = 0; f < b.n_facets(); ++f) {
     const double* a = &b.points[3 * std::size_t(b.facets[3 * f])];
     const double* c = &b.points[3 * std::size_t(b.facets[3 * f + 1])];
     const double* d = &b.points[3 * std::size_t(b.facets[3 * f + 2])];
-    vol6 += a[0] * (c[1] * d[2] - c[2] * d[1]) - a[1] * (c[0] * d[2] - c[2] * d[0]) +
-            a[2] * (c[0] * d[1] - c[1] * d[0]);
+    vol6 += a[0] * (c[1] * d[2] - c[2] * d[1]) - a[1] * (c[0] * d[2] - c[2] * d[0]) + a[2] * (c[0] * d[1] - c[1] * d[0]);
   }
   if (vol6 < 0)
-    for (std::size_t f = 0; f < b.facets.size(); f += 3)
-      std::swap(b.facets[f + 1], b.facets[f + 2]);
+    for (std::size_t f = 0; f < b.facets.size(); f += 3) std::swap(b.facets[f + 1], b.facets[f + 2]);
+}
 
+}  // namespace
+
+geometry::Boundary read_surface_file(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) bad_file(path, "surface file does not exist or is not a regular file");
+  const std::string ext = lower_extension(path);
+  if (!is_surface_extension(ext))
+    bad_file(path, "unsupported surface file extension '" + ext + "' (.stl or .msh expected)");
+  detail::ScopedModel model("surface_file");
+  merge_into_gmsh(path);
+  geometry::Boundary b = weld(path, read_triangles(path));
+  orient_outward(b);
   if (const auto check = geometry::check_boundary(b); !check.ok)
     bad_file(path, "not a valid closed surface: " + check.reason);
   return b;
