@@ -148,6 +148,85 @@ int run_shapes(MPI_Comm comm, const std::string& config_path, const std::string&
   return n_failed ? 3 : 0;
 }
 
+struct SolveArgs {
+  std::string scene, out = "solution.h5";
+  factory::SceneRuns runs;
+};
+struct ShapesArgs {
+  std::string config, out = "shapes.h5";
+  std::int64_t first = 0, count = -1;
+};
+struct GenerateArgs {
+  std::string config, out, preset;
+  bool mini = false;
+  factory::GenerateOptions options;
+};
+
+CLI::App* add_solve(CLI::App& app, SolveArgs& a) {
+  auto* solve = app.add_subcommand("solve", "solve one scene and write it to HDF5 + XDMF");
+  solve->add_option("scene", a.scene, "scene file (YAML); default: the embedded default scene");
+  solve->add_option("-o,--output", a.out, "output file (.h5); an .xdmf file is written beside it");
+  solve->add_option("--targets", a.runs.targets,
+                    "benchmarks: solve these targets (max|u|) in turn instead of load.target, each "
+                    "from rest on the same solver; each one's seconds, alpha, ... in /timings/")
+      ->delimiter(',')
+      ->check(CLI::Range(1e-12, 2.0));
+  solve->add_option("--repeat", a.runs.repeat, "benchmarks: solve the load case(s) N times")->check(CLI::PositiveNumber);
+  solve->allow_extras();
+  return solve;
+}
+
+CLI::App* add_shapes(CLI::App& app, ShapesArgs& a) {
+  auto* shapes = app.add_subcommand("shapes", "draw and mesh the random shapes of a dataset config");
+  shapes->add_option("config", a.config, "dataset config (YAML), e.g. configs/presets/random2d.yaml")->required();
+  shapes->add_option("-o,--output", a.out, "output file (.h5)");
+  shapes->add_option("--first", a.first, "first shape id")->check(CLI::NonNegativeNumber);
+  shapes->add_option("-n,--count", a.count, "number of shapes (default: shapes.count - first)");
+  shapes->allow_extras();
+  return shapes;
+}
+
+int env_int(const char* name, int fallback) {
+  const char* v = std::getenv(name);
+  return v && *v ? std::atoi(v) : fallback;
+}
+
+CLI::App* add_generate(CLI::App& app, GenerateArgs& a) {
+  auto* generate = app.add_subcommand("generate", "generate a dataset (shards, manifest, splits, statistics)");
+  factory::GenerateOptions& gen = a.options;
+  // SLURM array defaults: the task's offset in the array and the array's size.
+  gen.task_index = env_int("SLURM_ARRAY_TASK_ID", 0) - env_int("SLURM_ARRAY_TASK_MIN", 0);
+  gen.task_count = env_int("SLURM_ARRAY_TASK_COUNT", 1);
+  auto* config = generate->add_option("config", a.config, "dataset config (YAML); default: the embedded small dataset");
+  generate->add_option("--preset", a.preset, "an embedded preset (configs/presets/NAME.yaml) instead of a config")
+      ->excludes(config);
+  generate->add_flag("--mini", a.mini,
+                     "a few shapes and load cases of it (<= 4 shapes in 2D, 2 in 3D; 2 load cases, 4 for one "
+                     "shape; coarse grids): seconds, for docs and loaders; named NAME_mini");
+  generate->add_option("-o,--output", a.out, "output directory (default: results/<name>)");
+  generate->add_option("--task-index", gen.task_index, "this task's slice (default: $SLURM_ARRAY_TASK_ID - $SLURM_ARRAY_TASK_MIN)");
+  generate->add_option("--task-count", gen.task_count, "number of slices (default: $SLURM_ARRAY_TASK_COUNT or 1)");
+  generate->add_option("--group-size", gen.group_size, "ranks per shape (default 1)");
+  generate->add_option("--progress", gen.progress_seconds, "seconds between progress lines (0: none)");
+  generate->add_flag("--force", gen.force, "write a dataset above the size bound (1 TB) or the free disk space");
+  generate->allow_extras();
+  return generate;
+}
+
+int run_solve(MPI_Comm comm, const SolveArgs& a) {
+  // Validate everything that can be validated before any work or output.
+  check_output_path(a.out);
+  config::Scene scene = a.scene.empty()
+                            ? config::parse_scene_text(config::default_scene_text(), "<default scene>")
+                            : config::parse_scene_file(a.scene);
+  auto outcome = factory::solve_scene(comm, scene, a.runs);
+  auto t0 = core::now_seconds();
+  if (core::rank(comm) == 0) io::write_solution(a.out, outcome.record);
+  outcome.times.add("write", core::now_seconds() - t0);
+  core::info(comm, "{} -> {}", factory::summary_line(outcome), a.out);
+  return outcome.converged ? 0 : 3;
+}
+
 int run(int argc, char** argv) {
   MPI_Comm comm = PETSC_COMM_WORLD;
   const int rank = core::rank(comm);
@@ -157,56 +236,14 @@ int run(int argc, char** argv) {
   app.require_subcommand(1);
   bool quiet = false;
   app.add_flag("-q,--quiet", quiet, "print only errors");
-
-  auto* solve = app.add_subcommand("solve", "solve one scene and write it to HDF5 + XDMF");
-  std::string scene_path, out = "solution.h5";
-  solve->add_option("scene", scene_path, "scene file (YAML); default: the embedded default scene");
-  solve->add_option("-o,--output", out, "output file (.h5); an .xdmf file is written beside it");
-  factory::SceneRuns runs;
-  solve->add_option("--targets", runs.targets,
-                    "benchmarks: solve these targets (max|u|) in turn instead of load.target, each "
-                    "from rest on the same solver; each one's seconds, alpha, ... in /timings/")
-      ->delimiter(',')
-      ->check(CLI::Range(1e-12, 2.0));
-  solve->add_option("--repeat", runs.repeat, "benchmarks: solve the load case(s) N times")
-      ->check(CLI::PositiveNumber);
-  solve->allow_extras();
-  auto* shapes = app.add_subcommand("shapes", "draw and mesh the random shapes of a dataset config");
-  std::string shapes_config, shapes_out = "shapes.h5";
-  std::int64_t first = 0, count = -1;
-  shapes->add_option("config", shapes_config, "dataset config (YAML), e.g. configs/presets/random2d.yaml")->required();
-  shapes->add_option("-o,--output", shapes_out, "output file (.h5)");
-  shapes->add_option("--first", first, "first shape id")->check(CLI::NonNegativeNumber);
-  shapes->add_option("-n,--count", count, "number of shapes (default: shapes.count - first)");
-  shapes->allow_extras();
-  auto* generate = app.add_subcommand("generate", "generate a dataset (shards, manifest, splits, statistics)");
-  std::string gen_config, gen_out;
-  factory::GenerateOptions gen;
-  auto env_int = [](const char* name, int fallback) {
-    const char* v = std::getenv(name);
-    return v && *v ? std::atoi(v) : fallback;
-  };
-  // SLURM array defaults: the task's offset in the array and the array's size.
-  gen.task_index = env_int("SLURM_ARRAY_TASK_ID", 0) - env_int("SLURM_ARRAY_TASK_MIN", 0);
-  gen.task_count = env_int("SLURM_ARRAY_TASK_COUNT", 1);
-  auto* gen_config_opt =
-      generate->add_option("config", gen_config, "dataset config (YAML); default: the embedded small dataset");
-  std::string gen_preset;
-  bool gen_mini = false;
-  generate->add_option("--preset", gen_preset, "an embedded preset (configs/presets/NAME.yaml) instead of a config")
-      ->excludes(gen_config_opt);
-  generate->add_flag("--mini", gen_mini,
-                     "a few shapes and load cases of it (<= 4 shapes in 2D, 2 in 3D; 2 load cases, 4 for one "
-                     "shape; coarse grids): seconds, for docs and loaders; named NAME_mini");
-  generate->add_option("-o,--output", gen_out, "output directory (default: results/<name>)");
-  generate->add_option("--task-index", gen.task_index, "this task's slice (default: $SLURM_ARRAY_TASK_ID - $SLURM_ARRAY_TASK_MIN)");
-  generate->add_option("--task-count", gen.task_count, "number of slices (default: $SLURM_ARRAY_TASK_COUNT or 1)");
-  generate->add_option("--group-size", gen.group_size, "ranks per shape (default 1)");
-  generate->add_option("--progress", gen.progress_seconds, "seconds between progress lines (0: none)");
-  generate->add_flag("--force", gen.force, "write a dataset above the size bound (1 TB) or the free disk space");
-  generate->allow_extras();
-  auto* index = app.add_subcommand("index", "write the manifest, splits, statistics and XDMF of a dataset directory");
+  SolveArgs solve_args;
+  ShapesArgs shapes_args;
+  GenerateArgs gen;
   std::string index_dir;
+  add_solve(app, solve_args);
+  auto* shapes = add_shapes(app, shapes_args);
+  auto* generate = add_generate(app, gen);
+  auto* index = app.add_subcommand("index", "write the manifest, splits, statistics and XDMF of a dataset directory");
   index->add_option("dir", index_dir, "dataset directory")->required();
   index->allow_extras();
   auto* effects = app.add_subcommand("effects", "list the effects a scene may use");
@@ -222,7 +259,6 @@ int run(int argc, char** argv) {
     return e.get_exit_code() == 0 ? 0 : 2;
   }
   core::set_verbosity(quiet ? core::Verbosity::quiet : core::Verbosity::normal);
-
   if (*effects) {
     for (auto& [name, help] : physics::registered_effects()) core::info(comm, "{:20s} {}", name, help);
     return 0;
@@ -232,25 +268,15 @@ int run(int argc, char** argv) {
   extras.insert(extras.end(), lookalikes.begin(), lookalikes.end());
   const std::vector<std::string> petsc_names = petsc_option_names(extras);
   if (*generate) {
-    gen.petsc_command_line = petsc_names;  // checked by a trial solve before any work
-    return run_generate(comm, dataset_to_generate(gen_config, gen_preset, gen_mini), gen_out, gen);
+    gen.options.petsc_command_line = petsc_names;  // checked by a trial solve before any work
+    return run_generate(comm, dataset_to_generate(gen.config, gen.preset, gen.mini), gen.out, gen.options);
   }
   if (*index) {
     core::install_interrupt_handlers("index", rank);  // a manifest being replaced is removed
     return run_index(comm, index_dir);
   }
-  if (*shapes) return run_shapes(comm, shapes_config, shapes_out, first, count);
-  // Validate everything that can be validated before any work or output.
-  check_output_path(out);
-  config::Scene scene = scene_path.empty()
-                            ? config::parse_scene_text(config::default_scene_text(), "<default scene>")
-                            : config::parse_scene_file(scene_path);
-  auto outcome = factory::solve_scene(comm, scene, runs);
-  auto t0 = core::now_seconds();
-  if (rank == 0) io::write_solution(out, outcome.record);
-  outcome.times.add("write", core::now_seconds() - t0);
-  core::info(comm, "{} -> {}", factory::summary_line(outcome), out);
-  return outcome.converged ? 0 : 3;
+  if (*shapes) return run_shapes(comm, shapes_args.config, shapes_args.out, shapes_args.first, shapes_args.count);
+  return run_solve(comm, solve_args);  // the one subcommand left
 }
 
 }  // namespace
