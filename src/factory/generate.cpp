@@ -283,13 +283,7 @@ io::ShardHeader shard_header(const config::DatasetConfig& cfg, const OutputState
 void add_to_report(const ShapeJobResult& r, RunReport& rep) {
   rep.shapes += 1;
   rep.shapes_failed += r.entry.ok ? 0 : 1;
-  rep.loads_ok += r.loads_ok;
-  rep.loads_failed += r.loads_failed;
-  rep.newton_iterations += r.newton_iterations;
-  rep.solves += r.solves;
-  rep.failed_increments += r.failed_increments;
-  rep.recovery_iterations += r.recovery_iterations;
-  rep.linear += r.linear;
+  rep.counters += r.counters;
 }
 
 /// The run report's numbers over `comm`: counters summed over the group roots (each holds its
@@ -311,15 +305,7 @@ void reduce_report(MPI_Comm comm, bool group_root, const core::PhaseTimes& times
   };
   rep.shapes = sum_roots(rep.shapes);
   rep.shapes_failed = sum_roots(rep.shapes_failed);
-  rep.loads_ok = sum_roots(rep.loads_ok);
-  rep.loads_failed = sum_roots(rep.loads_failed);
-  rep.newton_iterations = sum_roots(rep.newton_iterations);
-  rep.solves = sum_roots(rep.solves);
-  rep.failed_increments = sum_roots(rep.failed_increments);
-  rep.recovery_iterations = sum_roots(rep.recovery_iterations);
-  for (std::int64_t* c : {&rep.linear.numeric_factorizations, &rep.linear.symbolic_factorizations,
-                          &rep.linear.krylov_iterations, &rep.linear.tangent_assemblies})
-    *c = sum_roots(*c);
+  rep.counters.sum_over(comm, group_root);
   rep.shards_written = sum_roots(shards_written);
   const std::vector<std::string> phases = {"shape", "mesh", "setup", "solve", "alpha_search",
                                            "representations", "gather", "io"};
@@ -355,15 +341,10 @@ bool report_and_index(const config::DatasetConfig& cfg, const GenerateOptions& o
   j["shards"] = {{"total", rep.shards_total}, {"done_before", rep.shards_done_before},
                  {"written", rep.shards_written}};
   j["shapes"] = {{"solved", rep.shapes}, {"failed", rep.shapes_failed}};
-  j["load_cases"] = {{"converged", rep.loads_ok}, {"failed", rep.loads_failed},
-                     {"per_second", (rep.loads_ok + rep.loads_failed) / std::max(1e-9, rep.seconds)}};
-  j["solver"] = {{"newton_iterations", rep.newton_iterations}, {"nonlinear_solves", rep.solves},
-                 {"failed_increments", rep.failed_increments},
-                 {"recovery_iterations", rep.recovery_iterations},
-                 {"numeric_factorizations", rep.linear.numeric_factorizations},
-                 {"symbolic_factorizations", rep.linear.symbolic_factorizations},
-                 {"krylov_iterations", rep.linear.krylov_iterations},
-                 {"tangent_assemblies", rep.linear.tangent_assemblies}};
+  const SolveCounters& c = rep.counters;
+  j["load_cases"] = {{"converged", c.loads_ok}, {"failed", c.loads_failed},
+                     {"per_second", double(c.loads()) / std::max(1e-9, rep.seconds)}};
+  j["solver"] = c.solver_json();
   j["seconds"] = {{"wall", rep.seconds}, {"phases_summed_over_groups", rep.phase_seconds},
                   {"factorization_PCSetUp_summed_over_ranks", rep.factorization_seconds}};
   j["peak_rss_mib_per_rank"] = rss;
@@ -454,7 +435,7 @@ RunReport generate(MPI_Comm comm, const config::DatasetConfig& cfg, const Genera
           print_progress(counters, false);
         });
         if (group_root) {
-          if (!r.entry.ok) counters.fetch_add(loads_failed, r.loads_failed);
+          if (!r.entry.ok) counters.fetch_add(loads_failed, r.counters.loads_failed);
           counters.fetch_add(shapes_done, 1);
           if (!r.entry.ok) counters.fetch_add(shapes_failed, 1);
           auto t = times.scope("io");
@@ -500,17 +481,18 @@ RunReport generate(MPI_Comm comm, const config::DatasetConfig& cfg, const Genera
 
 std::string report_table(const RunReport& r) {
   std::string s;
-  const double loads = double(r.loads_ok + r.loads_failed);
+  const SolveCounters& c = r.counters;
+  const double loads = double(c.loads());
   s += fmt::format("  shapes {} ({} failed), load cases {} converged, {} failed, in {:.1f} s: {:.2f} load cases/s\n",
-                   r.shapes, r.shapes_failed, r.loads_ok, r.loads_failed, r.seconds, loads / std::max(1e-9, r.seconds));
+                   r.shapes, r.shapes_failed, c.loads_ok, c.loads_failed, r.seconds, loads / std::max(1e-9, r.seconds));
   s += fmt::format("  Newton iterations {} in {} increments ({:.1f} per load case); {} failed increments "
-                   "cost {} of them\n", r.newton_iterations, r.solves, r.newton_iterations / std::max(1.0, loads),
-                   r.failed_increments, r.recovery_iterations);
-  const double ok = std::max<double>(1.0, double(r.loads_ok));
+                   "cost {} of them\n", c.newton_iterations, c.solves, double(c.newton_iterations) / std::max(1.0, loads),
+                   c.failed_increments, c.recovery_iterations);
+  const double ok = std::max<double>(1.0, double(c.loads_ok));
   s += fmt::format("  per converged load case: {:.2f} numeric factorisations, {:.2f} symbolic, {:.1f} Krylov "
-                   "iterations, {:.1f} tangent assemblies\n", double(r.linear.numeric_factorizations) / ok,
-                   double(r.linear.symbolic_factorizations) / ok, double(r.linear.krylov_iterations) / ok,
-                   double(r.linear.tangent_assemblies) / ok);
+                   "iterations, {:.1f} tangent assemblies\n", double(c.linear.numeric_factorizations) / ok,
+                   double(c.linear.symbolic_factorizations) / ok, double(c.linear.krylov_iterations) / ok,
+                   double(c.linear.tangent_assemblies) / ok);
   double total = 0;
   for (const auto& [k, v] : r.phase_seconds) total += v;
   s += "  phase              seconds   share\n";

@@ -226,34 +226,192 @@ double first_normaliser(const physics::Problem& p) {
   return 0.0;
 }
 
-}  // namespace
+/// The per-load-case rows of a shape ("loads/<name>", one row per load case), filled load case
+/// by load case and stored at the end. A failed load case keeps zeros (never NaN).
+struct LoadTable {
+  LoadTable(int n_loads, int d)
+      : d(d), status(std::size_t(n_loads), 0), reasons(std::size_t(n_loads)), alpha(std::size_t(n_loads), 0),
+        target(std::size_t(n_loads)), max_u(std::size_t(n_loads), 0), min_det(std::size_t(n_loads), 0),
+        normaliser(std::size_t(n_loads), 0), p_n(std::size_t(n_loads * d)), g(std::size_t(n_loads * d)),
+        newton(std::size_t(n_loads), 0), solves(std::size_t(n_loads), 0), failed_inc(std::size_t(n_loads), 0),
+        recovery(std::size_t(n_loads), 0) {}
 
-ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
-                         const std::optional<geometry::Boundary>& base, std::int64_t shape_id,
-                         const std::function<void(bool)>& on_load) {
-  ShapeJobResult out;
-  int rank = 0;
-  MPI_Comm_rank(group, &rank);
-  const bool root = rank == 0;
-  const int d = cfg.shapes.dim;
-  const int n_loads = cfg.loads.count;
+  void set_case(std::size_t L, const LoadCase& lc) {
+    target[L] = lc.target;
+    for (int k = 0; k < d; ++k) {
+      p_n[L * std::size_t(d) + std::size_t(k)] = lc.center[std::size_t(k)];
+      g[L * std::size_t(d) + std::size_t(k)] = lc.direction[std::size_t(k)];
+    }
+  }
+  void set_cost(std::size_t L, const solver::TargetResult& r) {
+    newton[L] = r.newton_iterations;
+    solves[L] = r.solves;
+    failed_inc[L] = r.failed_increments;
+    recovery[L] = r.recovery_iterations;
+  }
+  void store(std::vector<io::Array>& arrays, bool has_traction) const {
+    const U64 n = U64(status.size()), du = U64(d);
+    arrays.push_back(schema_array("loads/status", {n}, status));
+    arrays.push_back(schema_array("loads/alpha", {n}, alpha));
+    arrays.push_back(schema_array("loads/target", {n}, target));
+    arrays.push_back(schema_array("loads/max_displacement", {n}, max_u));
+    arrays.push_back(schema_array("loads/min_det_f", {n}, min_det));
+    if (has_traction) arrays.push_back(schema_array("loads/traction_normaliser", {n}, normaliser));
+    arrays.push_back(schema_array("loads/newton_iterations", {n}, newton));
+    arrays.push_back(schema_array("loads/solves", {n}, solves));
+    arrays.push_back(schema_array("loads/failed_increments", {n}, failed_inc));
+    arrays.push_back(schema_array("loads/recovery_iterations", {n}, recovery));
+    if (!has_traction) return;
+    arrays.push_back(schema_array("loads/p_n", {n, du}, p_n));
+    arrays.push_back(schema_array("loads/g", {n, du}, g));
+  }
 
-  // ---- the shape (every rank of the group draws the same one) ---------------------------------
+  int d;
+  std::vector<std::int8_t> status;
+  std::vector<std::string> reasons;
+  std::vector<double> alpha, target, max_u, min_det, normaliser, p_n, g;
+  std::vector<std::int64_t> newton, solves, failed_inc, recovery;
+};
+
+/// What a shape stores once (group root): the mesh, the boundary masks, the SDF and Dirichlet
+/// distance at the nodes and on the grid, and the sampler that takes nodal fields to the grid.
+struct ShapeFields {
+  int d = 0;
+  std::vector<double> nodes;
+  std::vector<std::int64_t> cells;
+  std::int64_t n_nodes = 0;
+  std::vector<std::int8_t> dirichlet_mask, neumann_mask;
+  std::vector<double> grid;  // grid points (empty without a grid)
+  std::uint64_t n_grid = 0;
+  std::vector<std::uint64_t> grid_shape;
+  std::unique_ptr<sampling::MeshSampler> sampler;
+};
+
+void add_mesh(const config::DatasetConfig& cfg, const ShapeSample& shape, const physics::Space& space, ShapeFields& f,
+              std::vector<io::Array>& arrays) {
+  const int d = f.d;
+  f.nodes = space.canonical_coords();
+  f.cells = space.canonical_cells();
+  f.n_nodes = std::int64_t(f.nodes.size()) / d;
+  const auto per_cell = std::uint64_t(f.cells.size()) / std::uint64_t(shape.mesh.n_cells());
+  arrays.push_back(schema_array("nodes", {U64(f.n_nodes), U64(d)}, f.nodes));
+  arrays.push_back(schema_array("cells", {U64(shape.mesh.n_cells()), per_cell}, f.cells));
+  boundary_node_masks(shape.boundary, shape.dirichlet_facets, f.cells, cfg.degree, f.n_nodes, f.dirichlet_mask,
+                      f.neumann_mask);
+  arrays.push_back(schema_array("dirichlet_mask", {U64(f.n_nodes)}, f.dirichlet_mask));
+  arrays.push_back(schema_array("neumann_mask", {U64(f.n_nodes)}, f.neumann_mask));
+}
+
+void add_distances(const config::DatasetConfig& cfg, const ShapeSample& shape, ShapeFields& f, Moments& moments,
+                   std::vector<io::Array>& arrays) {
+  const geometry::SignedDistance sdf(shape.boundary);
+  std::vector<std::int64_t> dfacets(shape.dirichlet_facets.begin(), shape.dirichlet_facets.end());
+  const geometry::FacetSetDistance ddist(shape.boundary, dfacets);
+  if (cfg.representations.point_cloud) {
+    std::vector<double> s(static_cast<std::size_t>(f.n_nodes)), dd(static_cast<std::size_t>(f.n_nodes));
+    sdf.evaluate(f.nodes, s);
+    ddist.evaluate(f.nodes, dd);
+    moments.add("sdf", s.data(), s.size(), 1);
+    moments.add("dirichlet_distance", dd.data(), dd.size(), 1);
+    arrays.push_back(schema_array("point_cloud/sdf", {U64(f.n_nodes)}, std::move(s)));
+    arrays.push_back(schema_array("point_cloud/dirichlet_distance", {U64(f.n_nodes)}, std::move(dd)));
+  }
+  if (!cfg.representations.grid) return;
+  const int N = cfg.representations.grid_size;
+  f.grid = sampling::grid_points(f.d, N);
+  f.n_grid = f.grid.size() / std::size_t(f.d);
+  f.grid_shape.assign(std::size_t(f.d), U64(N));
+  std::vector<double> s(f.n_grid), dd(f.n_grid);
+  sdf.evaluate(f.grid, s);
+  ddist.evaluate(f.grid, dd);
+  moments.add("grid_sdf", s.data(), s.size(), 1);
+  moments.add("grid_dirichlet_distance", dd.data(), dd.size(), 1);
+  arrays.push_back(schema_array("grid/sdf", f.grid_shape, to_float(s)));
+  arrays.push_back(schema_array("grid/dirichlet_distance", f.grid_shape, to_float(dd)));
+  f.sampler = std::make_unique<sampling::MeshSampler>(f.d, cfg.degree, f.nodes, f.cells, shape.boundary, sdf, f.grid);
+  const auto inside = f.sampler->inside();
+  arrays.push_back(schema_array("grid/inside", f.grid_shape, std::vector<std::int8_t>(inside.begin(), inside.end())));
+}
+
+ShapeFields shape_fields(const config::DatasetConfig& cfg, const ShapeSample& shape, const physics::Space& space,
+                         Moments& moments, std::vector<io::Array>& arrays) {
+  ShapeFields f;
+  f.d = cfg.shapes.dim;
+  add_mesh(cfg, shape, space, f, arrays);
+  add_distances(cfg, shape, f, moments, arrays);
+  return f;
+}
+
+/// The fields every converged load case stores (group root): u at the nodes and on the grid,
+/// and the scene's input channels.
+class LoadFields {
+ public:
+  LoadFields(const physics::Problem& p, const config::DatasetConfig& cfg, const ShapeFields& f, int n_loads)
+      : cfg_(cfg), f_(f), n_loads_(n_loads), channels_(p, cfg.representations) {}
+  void allocate() {
+    const int d = f_.d;
+    displacement_.assign(std::size_t(n_loads_ * f_.n_nodes * d), 0.0);
+    if (cfg_.representations.grid) grid_u_.assign(std::size_t(n_loads_) * f_.n_grid * std::size_t(d), 0.0f);
+    channels_.allocate(std::size_t(n_loads_ * f_.n_nodes), std::size_t(n_loads_) * f_.n_grid);
+  }
+  void fill(const physics::Problem& p, std::size_t L, double alpha, const std::vector<double>& u, Moments& moments) {
+    const int d = f_.d;
+    std::copy(u.begin(), u.end(), displacement_.begin() + std::ptrdiff_t(L * std::size_t(f_.n_nodes * d)));
+    moments.add("displacement", u.data(), u.size(), d);
+    channels_.fill(p, L, alpha, d, f_.nodes, f_.neumann_mask, f_.grid, moments);
+    if (cfg_.representations.grid) {
+      std::vector<double> gu(f_.n_grid * std::size_t(d));
+      f_.sampler->interpolate(u, d, gu);
+      std::copy(gu.begin(), gu.end(), grid_u_.begin() + std::ptrdiff_t(L * f_.n_grid * std::size_t(d)));
+      moments.add("grid_displacement", gu.data(), gu.size(), d);
+    }
+  }
+  void store(std::vector<io::Array>& arrays) {
+    const U64 n = U64(n_loads_), du = U64(f_.d);
+    arrays.push_back(schema_array("loads/displacement", {n, U64(f_.n_nodes), du}, std::move(displacement_)));
+    if (cfg_.representations.grid) {
+      std::vector<U64> s{n};
+      s.insert(s.end(), f_.grid_shape.begin(), f_.grid_shape.end());
+      s.push_back(du);
+      arrays.push_back(schema_array("loads/grid_displacement", s, std::move(grid_u_)));
+    }
+    channels_.store(arrays, n, U64(f_.n_nodes), f_.grid_shape);
+  }
+
+ private:
+  const config::DatasetConfig& cfg_;
+  const ShapeFields& f_;
+  int n_loads_;
+  Channels channels_;
+  std::vector<double> displacement_;
+  std::vector<float> grid_u_;
+};
+
+/// A shape with no acceptable draw: a failed entry, every load case failed.
+void record_failed_shape(const config::DatasetConfig& cfg, std::int64_t shape_id, const std::string& why,
+                         ShapeJobResult& out) {
+  out.entry.ok = false;
+  out.entry.failure = why;
+  out.entry.shape.shape_id = shape_id;
+  out.entry.shape.dim = cfg.shapes.dim;
+  out.entry.shape.rejected = why;
+  out.entry.shape.numbers = {{"failed", 1}};
+  out.entry.shape.source_file = source_file(cfg.shapes, shape_id);
+  out.counters.loads_failed = cfg.loads.count;
+}
+
+/// The shape of `shape_id` (every rank of the group draws the same one), or nothing when no
+/// draw is acceptable (then `out` holds the failed entry).
+std::optional<ShapeSample> draw_shape(const config::DatasetConfig& cfg, const std::optional<geometry::Boundary>& base,
+                                      std::int64_t shape_id, ShapeJobResult& out) {
   ShapeSample shape;
   {
     auto t = out.times.scope("shape");
     try {
       shape = make_shape(shape_config(cfg, shape_id), base, cfg.seed, shape_id);
     } catch (const std::runtime_error& e) {
-      out.entry.ok = false;
-      out.entry.failure = e.what();
-      out.entry.shape.shape_id = shape_id;
-      out.entry.shape.dim = d;
-      out.entry.shape.rejected = e.what();
-      out.entry.shape.numbers = {{"failed", 1}};
-      out.entry.shape.source_file = source_file(cfg.shapes, shape_id);
-      out.loads_failed = n_loads;
-      return out;
+      record_failed_shape(cfg, shape_id, e.what(), out);
+      return std::nullopt;
     }
   }
   out.times.add("mesh", shape.seconds_mesh);
@@ -261,190 +419,108 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
   out.entry.shape = to_record(shape);
   for (auto it = out.entry.shape.numbers.begin(); it != out.entry.shape.numbers.end();)
     it = it->first.rfind("seconds_", 0) == 0 ? out.entry.shape.numbers.erase(it) : std::next(it);
-  const auto cases = draw_load_cases(shape, cfg.loads, cfg.seed, n_tractions(cfg));
+  return shape;
+}
 
-  // ---- the problem, set up once for all load cases --------------------------------------------
+/// One load case solved and checked: its outcome (converged, finite, no inverted cell) and,
+/// when it converged, the displacement at the nodes (on the group root).
+struct LoadOutcome {
+  bool ok = false;
+  std::string reason;
+  solver::TargetResult result;
+  double max_u = 0, min_det = 0;
+  physics::NodalField u;
+};
+
+LoadOutcome solve_load_case(MPI_Comm group, const config::DatasetConfig& cfg, const ShapeSample& shape,
+                            ShapeProblem& sp, solver::NonlinearSolver& nl, const LoadCase& lc, core::PhaseTimes& times,
+                            double& normaliser) {
+  LoadOutcome o;
+  std::string failure;
+  try {
+    {
+      auto t = times.scope("setup");
+      sp.set_load_case(cfg, shape, lc);
+    }
+    normaliser = first_normaliser(*sp.problem);
+    nl.reset();
+    o.result = nl.solve_for_target(lc.target);
+    times.add("solve", o.result.seconds_first_solve);
+    times.add("alpha_search", o.result.seconds_total - o.result.seconds_first_solve);
+  } catch (const std::runtime_error& e) {  // PETSc's and the solver's failures: data
+    failure = std::string("error: ") + e.what();
+  }  // a std::logic_error is a bug: it ends the run (the shard is redone on resume)
+  o.ok = failure.empty() && o.result.converged;
+  {
+    auto t = times.scope("gather");
+    const physics::Problem& problem = *sp.problem;
+    o.max_u = problem.max_displacement(nl.solution());
+    o.min_det = problem.min_det_f(nl.solution());
+    o.u = problem.gather(nl.solution());
+    if (o.ok && !(std::isfinite(o.max_u) && std::isfinite(o.min_det))) o.ok = false, failure = "non-finite displacement";
+    if (o.ok && !(o.min_det > 0)) o.ok = false, failure = "inverted cells (min det F <= 0)";
+  }
+  if (core::rank(group) == 0 && o.ok && !all_finite(o.u.values)) o.ok = false, failure = "non-finite displacement";
+  MPI_Bcast(&o.ok, 1, MPI_CXX_BOOL, 0, group);
+  o.reason = o.ok ? o.result.reason : (failure.empty() ? o.result.reason : failure);
+  return o;
+}
+
+}  // namespace
+
+ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
+                         const std::optional<geometry::Boundary>& base, std::int64_t shape_id,
+                         const std::function<void(bool)>& on_load) {
+  ShapeJobResult out;
+  const bool root = core::rank(group) == 0;
+  const int n_loads = cfg.loads.count;
+  const std::optional<ShapeSample> shape = draw_shape(cfg, base, shape_id, out);
+  if (!shape) return out;
+  const auto cases = draw_load_cases(*shape, cfg.loads, cfg.seed, n_tractions(cfg));
   ShapeProblem sp;
   std::unique_ptr<solver::NonlinearSolver> nl;
-  {
+  {  // the problem, set up once for all load cases
     auto t = out.times.scope("setup");
-    sp = make_shape_problem(group, cfg, shape, cases[0]);
+    sp = make_shape_problem(group, cfg, *shape, cases[0]);
     nl = std::make_unique<solver::NonlinearSolver>(*sp.problem, cfg.solver);
   }
-  const physics::Problem* problem = sp.problem.get();
-  const auto& space = problem->space();
-  out.n_dofs = space.n_dofs_global();
-
-  // ---- per-shape representations (group root) -------------------------------------------------
+  out.n_dofs = sp.problem->space().n_dofs_global();
   auto& arrays = out.entry.arrays;
   Moments moments;
-  std::vector<double> nodes;
-  std::vector<std::int64_t> cells;
-  std::int64_t n_nodes = 0;
-  std::vector<std::int8_t> dirichlet_mask, neumann_mask;
-  std::unique_ptr<sampling::MeshSampler> sampler;
-  std::vector<double> grid;
-  const int N = cfg.representations.grid_size;
-  std::uint64_t n_grid = 0;
-  std::vector<std::uint64_t> grid_shape;
+  ShapeFields fields;
   if (root) {
     auto t = out.times.scope("representations");
-    nodes = space.canonical_coords();
-    cells = space.canonical_cells();
-    n_nodes = std::int64_t(nodes.size()) / d;
-    const auto per_cell = std::uint64_t(cells.size()) / std::uint64_t(shape.mesh.n_cells());
-    arrays.push_back(schema_array("nodes", {U64(n_nodes), U64(d)}, nodes));
-    arrays.push_back(schema_array("cells", {U64(shape.mesh.n_cells()), per_cell}, cells));
-    boundary_node_masks(shape.boundary, shape.dirichlet_facets, cells, cfg.degree, n_nodes, dirichlet_mask,
-                        neumann_mask);
-    arrays.push_back(schema_array("dirichlet_mask", {U64(n_nodes)}, dirichlet_mask));
-    arrays.push_back(schema_array("neumann_mask", {U64(n_nodes)}, neumann_mask));
-    const geometry::SignedDistance sdf(shape.boundary);
-    std::vector<std::int64_t> dfacets(shape.dirichlet_facets.begin(), shape.dirichlet_facets.end());
-    const geometry::FacetSetDistance ddist(shape.boundary, dfacets);
-    if (cfg.representations.point_cloud) {
-      std::vector<double> s(static_cast<std::size_t>(n_nodes)), dd(static_cast<std::size_t>(n_nodes));
-      sdf.evaluate(nodes, s);
-      ddist.evaluate(nodes, dd);
-      moments.add("sdf", s.data(), s.size(), 1);
-      moments.add("dirichlet_distance", dd.data(), dd.size(), 1);
-      arrays.push_back(schema_array("point_cloud/sdf", {U64(n_nodes)}, std::move(s)));
-      arrays.push_back(schema_array("point_cloud/dirichlet_distance", {U64(n_nodes)}, std::move(dd)));
-    }
-    if (cfg.representations.grid) {
-      grid = sampling::grid_points(d, N);
-      n_grid = grid.size() / std::size_t(d);
-      grid_shape.assign(std::size_t(d), U64(N));
-      std::vector<double> s(n_grid), dd(n_grid);
-      sdf.evaluate(grid, s);
-      ddist.evaluate(grid, dd);
-      moments.add("grid_sdf", s.data(), s.size(), 1);
-      moments.add("grid_dirichlet_distance", dd.data(), dd.size(), 1);
-      arrays.push_back(schema_array("grid/sdf", grid_shape, to_float(s)));
-      arrays.push_back(schema_array("grid/dirichlet_distance", grid_shape, to_float(dd)));
-      sampler = std::make_unique<sampling::MeshSampler>(d, cfg.degree, nodes, cells, shape.boundary, sdf, grid);
-      const auto inside = sampler->inside();
-      arrays.push_back(schema_array("grid/inside", grid_shape, std::vector<std::int8_t>(inside.begin(), inside.end())));
-    }
+    fields = shape_fields(cfg, *shape, sp.problem->space(), moments, arrays);
   }
-
-  // ---- load cases -----------------------------------------------------------------------------
-  std::vector<std::int8_t> status(std::size_t(n_loads), 0);
-  std::vector<std::string> reasons(static_cast<std::size_t>(n_loads));
-  std::vector<double> alpha(std::size_t(n_loads), 0), target(static_cast<std::size_t>(n_loads)), max_u(std::size_t(n_loads), 0),
-      min_det(std::size_t(n_loads), 0), normaliser(std::size_t(n_loads), 0), p_n(std::size_t(n_loads * d)),
-      g(std::size_t(n_loads * d));
-  std::vector<std::int64_t> newton(std::size_t(n_loads), 0), solves(std::size_t(n_loads), 0),
-      failed_inc(std::size_t(n_loads), 0), recovery(std::size_t(n_loads), 0);
-  std::vector<double> displacement;
-  std::vector<float> grid_u;
-  Channels channels(*problem, cfg.representations);
+  LoadTable table(n_loads, cfg.shapes.dim);
+  LoadFields load_fields(*sp.problem, cfg, fields, n_loads);
   DrawnParams drawn(cfg, shape_id, n_loads);
-  if (root) {
-    displacement.assign(std::size_t(n_loads * n_nodes * d), 0.0);
-    if (cfg.representations.grid) grid_u.assign(std::size_t(n_loads) * n_grid * std::size_t(d), 0.0f);
-    channels.allocate(std::size_t(n_loads * n_nodes), std::size_t(n_loads) * n_grid);
-  }
+  if (root) load_fields.allocate();
   for (int l = 0; l < n_loads; ++l) {
-    const LoadCase& lc = cases[std::size_t(l)];
     const auto L = std::size_t(l);
-    target[L] = lc.target;
-    for (int k = 0; k < d; ++k) {
-      p_n[L * std::size_t(d) + std::size_t(k)] = lc.center[std::size_t(k)];
-      g[L * std::size_t(d) + std::size_t(k)] = lc.direction[std::size_t(k)];
-    }
-    drawn.add(lc);  // before anything that may fail: one row per load case
-    solver::TargetResult r;
-    std::string failure;
-    try {
-      {
-        auto t = out.times.scope("setup");
-        sp.set_load_case(cfg, shape, lc);
-      }
-      normaliser[L] = first_normaliser(*problem);
-      nl->reset();
-      r = nl->solve_for_target(lc.target);
-      out.times.add("solve", r.seconds_first_solve);
-      out.times.add("alpha_search", r.seconds_total - r.seconds_first_solve);
-    } catch (const std::runtime_error& e) {  // PETSc's and the solver's failures: data
-      failure = std::string("error: ") + e.what();
-    }  // a std::logic_error is a bug: it ends the run (the shard is redone on resume)
-    newton[L] = r.newton_iterations;
-    solves[L] = r.solves;
-    failed_inc[L] = r.failed_increments;
-    recovery[L] = r.recovery_iterations;
-    out.recovery_iterations += r.recovery_iterations;
-    out.newton_iterations += r.newton_iterations;
-    out.linear += r.linear;
-    out.solves += r.solves;
-    out.failed_increments += r.failed_increments;
-    bool ok = failure.empty() && r.converged;
-    physics::NodalField u;
-    {
-      auto t = out.times.scope("gather");
-      const double m = problem->max_displacement(nl->solution());
-      const double j = problem->min_det_f(nl->solution());
-      u = problem->gather(nl->solution());
-      if (ok && !(std::isfinite(m) && std::isfinite(j))) ok = false, failure = "non-finite displacement";
-      if (ok && !(j > 0)) ok = false, failure = "inverted cells (min det F <= 0)";
-      if (ok) max_u[L] = m, min_det[L] = j, alpha[L] = r.alpha;
-    }
-    if (root && ok && !all_finite(u.values)) ok = false, failure = "non-finite displacement";
-    MPI_Bcast(&ok, 1, MPI_CXX_BOOL, 0, group);
-    status[L] = ok ? 1 : 0;
-    reasons[L] = ok ? r.reason : (failure.empty() ? r.reason : failure);
-    (ok ? out.loads_ok : out.loads_failed) += 1;
-    if (on_load) on_load(ok);
-    if (!ok) {
-      max_u[L] = min_det[L] = alpha[L] = 0;  // the fields stay zero: never NaN
-      continue;
-    }
+    table.set_case(L, cases[L]);
+    drawn.add(cases[L]);  // before anything that may fail: one row per load case
+    LoadOutcome o = solve_load_case(group, cfg, *shape, sp, *nl, cases[L], out.times, table.normaliser[L]);
+    table.set_cost(L, o.result);
+    out.counters.add(o.result);
+    table.status[L] = o.ok ? 1 : 0;
+    table.reasons[L] = o.reason;
+    (o.ok ? out.counters.loads_ok : out.counters.loads_failed) += 1;
+    if (on_load) on_load(o.ok);
+    if (!o.ok) continue;  // the row and the fields stay zero: never NaN
+    table.max_u[L] = o.max_u, table.min_det[L] = o.min_det, table.alpha[L] = o.result.alpha;
     if (!root) continue;
     auto t = out.times.scope("representations");
-    const std::size_t off = L * std::size_t(n_nodes * d);
-    std::copy(u.values.begin(), u.values.end(), displacement.begin() + std::ptrdiff_t(off));
-    moments.add("displacement", u.values.data(), u.values.size(), d);
-    channels.fill(*problem, L, alpha[L], d, nodes, neumann_mask, grid, moments);
-    if (cfg.representations.grid) {
-      const std::size_t goff = L * n_grid * std::size_t(d);
-      std::vector<double> gu(n_grid * std::size_t(d));
-      sampler->interpolate(u.values, d, gu);
-      std::copy(gu.begin(), gu.end(), grid_u.begin() + std::ptrdiff_t(goff));
-      moments.add("grid_displacement", gu.data(), gu.size(), d);
-    }
-    moments.add("alpha", &alpha[L], 1, 1);
+    load_fields.fill(*sp.problem, L, table.alpha[L], o.u.values, moments);
+    moments.add("alpha", &table.alpha[L], 1, 1);
   }
-
   if (root) {
     auto t = out.times.scope("representations");
-    const U64 nl_ = U64(n_loads), du = U64(d);
-    const bool has_traction = n_tractions(cfg) > 0;
-    arrays.push_back(schema_array("loads/status", {nl_}, status));
-    arrays.push_back(schema_array("loads/alpha", {nl_}, alpha));
-    arrays.push_back(schema_array("loads/target", {nl_}, target));
-    arrays.push_back(schema_array("loads/max_displacement", {nl_}, max_u));
-    arrays.push_back(schema_array("loads/min_det_f", {nl_}, min_det));
-    if (has_traction)
-      arrays.push_back(schema_array("loads/traction_normaliser", {nl_}, normaliser));
-    arrays.push_back(schema_array("loads/newton_iterations", {nl_}, newton));
-    arrays.push_back(schema_array("loads/solves", {nl_}, solves));
-    arrays.push_back(schema_array("loads/failed_increments", {nl_}, failed_inc));
-    arrays.push_back(schema_array("loads/recovery_iterations", {nl_}, recovery));
-    if (has_traction) {
-      arrays.push_back(schema_array("loads/p_n", {nl_, du}, p_n));
-      arrays.push_back(schema_array("loads/g", {nl_, du}, g));
-    }
-    arrays.push_back(schema_array("loads/displacement", {nl_, U64(n_nodes), du}, std::move(displacement)));
-    if (cfg.representations.grid) {
-      std::vector<U64> s{nl_};
-      s.insert(s.end(), grid_shape.begin(), grid_shape.end());
-      s.push_back(du);
-      arrays.push_back(schema_array("loads/grid_displacement", s, std::move(grid_u)));
-    }
-    channels.store(arrays, nl_, U64(n_nodes), grid_shape);
+    table.store(arrays, n_tractions(cfg) > 0);
+    load_fields.store(arrays);
     drawn.store(arrays);
     moments.store(arrays);
-    out.entry.load_reasons = std::move(reasons);
+    out.entry.load_reasons = std::move(table.reasons);
   }
   return out;
 }

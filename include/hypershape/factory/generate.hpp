@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "hypershape/config/dataset.hpp"
+#include "hypershape/factory/solve_counters.hpp"
 
 namespace hypershape::factory {
 
@@ -38,9 +39,8 @@ struct GenerateOptions {
 
 struct RunReport {
   std::int64_t shards_total = 0, shards_done_before = 0, shards_written = 0;
-  std::int64_t shapes = 0, shapes_failed = 0, loads_ok = 0, loads_failed = 0;
-  std::int64_t newton_iterations = 0, solves = 0, failed_increments = 0, recovery_iterations = 0;
-  solver::LinearCounters linear;  ///< summed over the run's load cases
+  std::int64_t shapes = 0, shapes_failed = 0;
+  SolveCounters counters;  ///< summed over the run's load cases
   double seconds = 0;
   std::map<std::string, double> phase_seconds;  ///< summed over group roots
   double factorization_seconds = 0;             ///< PCSetUp, summed over ranks

@@ -15,6 +15,7 @@
 #include "hypershape/factory/dataset_scene.hpp"
 #include "hypershape/factory/load_cases.hpp"
 #include "hypershape/factory/shape_pipeline.hpp"
+#include "hypershape/factory/solve_counters.hpp"
 #include "hypershape/geometry/boundary.hpp"
 #include "hypershape/io/dataset_shard.hpp"
 #include "hypershape/physics/problem.hpp"
@@ -24,9 +25,7 @@ namespace hypershape::factory {
 
 struct ShapeJobResult {
   io::ShardShape entry;      ///< significant on rank 0 of the group
-  int loads_ok = 0, loads_failed = 0;
-  int newton_iterations = 0, solves = 0, failed_increments = 0, recovery_iterations = 0;
-  solver::LinearCounters linear;  ///< factorisations, Krylov iterations, tangent assemblies
+  SolveCounters counters;    ///< the shape's load cases: outcomes and solver work
   std::int64_t n_dofs = 0;
   /// shape (draw + boundary + checks), mesh, setup, solve (first nonlinear solve of each load
   /// case), alpha_search (the further solves), representations, gather.
