@@ -363,13 +363,123 @@ bool report_and_index(const config::DatasetConfig& cfg, const GenerateOptions& o
   return complete;
 }
 
+/// The progress line (rank 0, every `progress_seconds`): shapes and load cases done of this
+/// task's, failures, rate, elapsed time and ETA.
+class Progress {
+ public:
+  Progress(MPI_Comm comm, const GenerateOptions& opt, double start, std::int64_t todo_shapes, std::int64_t todo_loads)
+      : comm_(comm), period_(opt.progress_seconds), start_(start), last_(start), todo_shapes_(todo_shapes),
+        todo_loads_(todo_loads), on_(core::rank(comm) == 0 && opt.progress_seconds > 0) {}
+  void print(SharedCounters& c, bool force) {
+    if (!on_) return;
+    const double now = core::now_seconds();
+    if (!force && now - last_ < period_) return;
+    last_ = now;
+    const auto v = c.read();
+    const std::int64_t loads = v[loads_ok] + v[loads_failed];
+    const double rate = double(loads) / std::max(1e-9, now - start_);
+    core::info(comm_, "[generate] {}/{} shapes, {}/{} load cases ({} failed, {} shapes failed), {:.2f} load cases/s, "
+               "elapsed {}, ETA {}", v[shapes_done], todo_shapes_, loads, todo_loads_, v[loads_failed],
+               v[shapes_failed], rate, format_duration(now - start_),
+               format_duration(rate > 0 ? double(todo_loads_ - loads) / rate : NAN));
+  }
+  /// Rank 0 keeps the line going until every group is done.
+  void until_done(SharedCounters& c) {
+    if (!on_) return;
+    while (c.read()[shapes_done] < todo_shapes_) {
+      print(c, false);
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+  }
+
+ private:
+  MPI_Comm comm_;
+  double period_, start_, last_;
+  std::int64_t todo_shapes_, todo_loads_;
+  bool on_;
+};
+
+/// The solver groups' work: shards taken from the shared queue one at a time, each solved shape
+/// by shape and written (group root) under a temporary name, recorded, renamed.
+class ShardRunner {
+ public:
+  ShardRunner(MPI_Comm comm, const config::DatasetConfig& cfg, const GenerateOptions& opt, const OutputState& out,
+              const std::optional<geometry::Boundary>& base, const DatasetEstimate& est, RunReport& rep)
+      : cfg_(cfg), opt_(opt), out_(out), base_(base), est_(est), rep_(rep), software_(software_versions()) {
+    MPI_Comm_split(comm, core::rank(comm) / opt.group_size, core::rank(comm), &group_);
+    group_root_ = core::rank(group_) == 0;
+  }
+  ~ShardRunner() { MPI_Comm_free(&group_); }
+  ShardRunner(const ShardRunner&) = delete;
+  ShardRunner& operator=(const ShardRunner&) = delete;
+
+  void run(SharedCounters& counters, Progress& progress) {
+    while (true) {
+      std::int64_t slot = 0;
+      if (group_root_) slot = counters.fetch_add(next_shard, 1);
+      MPI_Bcast(&slot, 1, MPI_INT64_T, 0, group_);
+      if (slot >= std::int64_t(out_.todo.size())) break;
+      run_shard(out_.todo[std::size_t(slot)], counters, progress);
+    }
+  }
+  bool group_root() const { return group_root_; }
+  const core::PhaseTimes& times() const { return times_; }
+  std::int64_t shards_written() const { return shards_written_; }
+  const std::map<std::string, std::string>& software() const { return software_; }
+
+ private:
+  void run_shard(std::int64_t k, SharedCounters& counters, Progress& progress) {
+    const std::int64_t S = cfg_.shard_size, first = k * S, n = std::min(S, cfg_.n_shapes - first);
+    std::unique_ptr<io::ShardWriter> writer;
+    if (group_root_) {
+      check_shard_space(opt_.output_dir, k, est_.bytes_per_shape * double(n));
+      writer = std::make_unique<io::ShardWriter>((fs::path(opt_.output_dir) / "shards" / shard_name(k)).string(),
+                                                 shard_header(cfg_, out_, software_, k));
+    }
+    for (std::int64_t id = first; id < first + n; ++id) {
+      ShapeJobResult r = run_shape(group_, cfg_, base_, id, [&](bool ok) {
+        if (group_root_) counters.fetch_add(ok ? loads_ok : loads_failed, 1);
+        progress.print(counters, false);
+      });
+      if (group_root_) {
+        if (!r.entry.ok) counters.fetch_add(loads_failed, r.counters.loads_failed);
+        counters.fetch_add(shapes_done, 1);
+        if (!r.entry.ok) counters.fetch_add(shapes_failed, 1);
+        auto t = times_.scope("io");
+        writer->add(r.entry);
+      }
+      for (const auto& [name, sec] : r.times.all()) times_.add(name, sec);
+      add_to_report(r, rep_);
+      if (!r.entry.ok)
+        core::log_line(MPI_COMM_SELF, core::Verbosity::normal,
+                       fmt::format("[generate] shape {} failed: {}", id, r.entry.failure.substr(0, 300)));
+    }
+    if (!group_root_) return;
+    auto t = times_.scope("io");
+    writer->commit([&](std::uint32_t crc, std::uint64_t bytes) {
+      write_shard_record(opt_.output_dir, shard_identity(cfg_, out_.hash, k), crc, bytes);
+    });
+    ++shards_written_;
+  }
+
+  MPI_Comm group_;
+  bool group_root_ = false;
+  const config::DatasetConfig& cfg_;
+  const GenerateOptions& opt_;
+  const OutputState& out_;
+  const std::optional<geometry::Boundary>& base_;
+  const DatasetEstimate& est_;
+  RunReport& rep_;
+  std::map<std::string, std::string> software_;
+  core::PhaseTimes times_;
+  std::int64_t shards_written_ = 0;
+};
+
 }  // namespace
 
 RunReport generate(MPI_Comm comm, const config::DatasetConfig& cfg, const GenerateOptions& opt) {
   const double start = core::now_seconds();
-  int rank = 0, size = 1;
-  MPI_Comm_rank(comm, &rank);
-  MPI_Comm_size(comm, &size);
+  const int size = core::size(comm);
   RunReport rep;
   const std::int64_t S = cfg.shard_size;
   rep.shards_total = (cfg.n_shapes + S - 1) / S;
@@ -377,102 +487,28 @@ RunReport generate(MPI_Comm comm, const config::DatasetConfig& cfg, const Genera
   const std::optional<geometry::Boundary> base = load_dataset_base(cfg);
   const DatasetEstimate est = estimate_dataset(cfg);
   OutputState out = prepare_run(comm, cfg, opt, est, rep.shards_total);
-  std::vector<std::int64_t>& todo = out.todo;
-  const std::int64_t done_before = out.done_before;
-  rep.shards_done_before = done_before;
+  rep.shards_done_before = out.done_before;
   HS_PETSC(PetscLogDefaultBegin());
-
   std::int64_t todo_shapes = 0;
-  for (auto k : todo) todo_shapes += std::min<std::int64_t>(S, cfg.n_shapes - k * S);
+  for (auto k : out.todo) todo_shapes += std::min<std::int64_t>(S, cfg.n_shapes - k * S);
   const std::int64_t todo_loads = todo_shapes * cfg.loads.count;
   core::info(comm, "[generate] {}: {} shapes x {} load cases, {} shards ({} done before, {} to do by task {}/{}), "
              "{} ranks in groups of {} -> {}",
-             cfg.name, cfg.n_shapes, cfg.loads.count, rep.shards_total, done_before, todo.size(),
+             cfg.name, cfg.n_shapes, cfg.loads.count, rep.shards_total, out.done_before, out.todo.size(),
              opt.task_index, opt.task_count, size, opt.group_size, opt.output_dir);
-
-  MPI_Comm group;
-  MPI_Comm_split(comm, rank / opt.group_size, rank, &group);
-  int grank = 0;
-  MPI_Comm_rank(group, &grank);
-  const bool group_root = grank == 0;
-  const std::string& hash = out.hash;
-  const auto software = software_versions();
-
-  core::PhaseTimes times;
-  std::int64_t shards_written = 0;
-  double last_print = core::now_seconds();
-  auto print_progress = [&](SharedCounters& c, bool force) {
-    if (rank != 0 || opt.progress_seconds <= 0) return;
-    const double now = core::now_seconds();
-    if (!force && now - last_print < opt.progress_seconds) return;
-    last_print = now;
-    const auto v = c.read();
-    const std::int64_t loads = v[loads_ok] + v[loads_failed];
-    const double rate = loads / std::max(1e-9, now - start);
-    core::info(comm, "[generate] {}/{} shapes, {}/{} load cases ({} failed, {} shapes failed), {:.2f} load cases/s, "
-               "elapsed {}, ETA {}", v[shapes_done], todo_shapes, loads, todo_loads, v[loads_failed],
-               v[shapes_failed], rate, format_duration(now - start),
-               format_duration(rate > 0 ? (todo_loads - loads) / rate : NAN));
-  };
+  ShardRunner runner(comm, cfg, opt, out, base, est, rep);
   {
     SharedCounters counters(comm);
-    while (true) {
-      std::int64_t slot = 0;
-      if (group_root) slot = counters.fetch_add(next_shard, 1);
-      MPI_Bcast(&slot, 1, MPI_INT64_T, 0, group);
-      if (slot >= std::int64_t(todo.size())) break;
-      const std::int64_t k = todo[std::size_t(slot)];
-      const std::int64_t first = k * S, n = std::min(S, cfg.n_shapes - first);
-      std::unique_ptr<io::ShardWriter> writer;
-      if (group_root) {
-        check_shard_space(opt.output_dir, k, est.bytes_per_shape * double(n));
-        writer = std::make_unique<io::ShardWriter>((fs::path(opt.output_dir) / "shards" / shard_name(k)).string(),
-                                                   shard_header(cfg, out, software, k));
-      }
-      for (std::int64_t id = first; id < first + n; ++id) {
-        ShapeJobResult r = run_shape(group, cfg, base, id, [&](bool ok) {
-          if (group_root) counters.fetch_add(ok ? loads_ok : loads_failed, 1);
-          print_progress(counters, false);
-        });
-        if (group_root) {
-          if (!r.entry.ok) counters.fetch_add(loads_failed, r.counters.loads_failed);
-          counters.fetch_add(shapes_done, 1);
-          if (!r.entry.ok) counters.fetch_add(shapes_failed, 1);
-          auto t = times.scope("io");
-          writer->add(r.entry);
-        }
-        for (const auto& [name, s] : r.times.all()) times.add(name, s);
-        add_to_report(r, rep);
-        if (!r.entry.ok)
-          core::log_line(MPI_COMM_SELF, core::Verbosity::normal,
-                         fmt::format("[generate] shape {} failed: {}", id, r.entry.failure.substr(0, 300)));
-      }
-      if (group_root) {
-        auto t = times.scope("io");
-        writer->commit([&](std::uint32_t crc, std::uint64_t bytes) {
-          write_shard_record(opt.output_dir, shard_identity(cfg, hash, k), crc, bytes);
-        });
-        ++shards_written;
-      }
-    }
-    // Rank 0 keeps the progress line going until every group is done.
-    if (rank == 0 && opt.progress_seconds > 0) {
-      while (true) {
-        const auto v = counters.read();
-        if (v[shapes_done] >= todo_shapes) break;
-        print_progress(counters, false);
-        std::this_thread::sleep_for(std::chrono::milliseconds(100));
-      }
-    }
+    Progress progress(comm, opt, start, todo_shapes, todo_loads);
+    runner.run(counters, progress);
+    progress.until_done(counters);
     MPI_Barrier(comm);
-    if (rank == 0 && todo_shapes > 0) print_progress(counters, true);
+    if (todo_shapes > 0) progress.print(counters, true);
   }
-  MPI_Comm_free(&group);
-
   std::vector<double> rss;
-  reduce_report(comm, group_root, times, shards_written, start, rep, rss);
+  reduce_report(comm, runner.group_root(), runner.times(), runner.shards_written(), start, rep, rss);
   int complete = 0;
-  core::on_root(comm, [&] { complete = report_and_index(cfg, opt, size, rep, rss, software) ? 1 : 0; });
+  core::on_root(comm, [&] { complete = report_and_index(cfg, opt, size, rep, rss, runner.software()) ? 1 : 0; });
   MPI_Bcast(&complete, 1, MPI_INT, 0, comm);
   rep.indexed = complete == 1;
   core::remove_interrupt_handlers();
