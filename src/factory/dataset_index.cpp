@@ -48,96 +48,77 @@ std::map<std::string, std::vector<std::int64_t>> make_splits(const config::Datas
   return out;
 }
 
-}  // namespace
-
-IndexReport index_dataset(const std::string& dir) {
-  const fs::path root(dir);
-  const fs::path yaml = root / "dataset.yaml";
-  if (!fs::exists(yaml)) throw core::InputError(dir, "", "not a dataset directory (no dataset.yaml)");
-  const config::DatasetConfig cfg = config::parse_dataset_file(yaml.string());
-  // The shards carry the digest of the dataset's meaning (config::canonical_text).
-  const std::string hash = config_hash(cfg);
-  IndexReport rep;
-  rep.shards = (cfg.n_shapes + cfg.shard_size - 1) / cfg.shard_size;
-
-  json shards = json::array();
-  std::vector<std::int64_t> failed_shapes;
-  std::map<std::int64_t, const io::ShardSummary::Shape*> by_id;
-  std::vector<io::ShardSummary> summaries;
-  summaries.reserve(std::size_t(rep.shards));
-  for (std::int64_t k = 0; k < rep.shards; ++k) {
-    const fs::path p = root / "shards" / shard_name(k);
-    if (!fs::exists(p)) {
-      rep.missing_shards.push_back(k);
-      continue;
-    }
-    if (const auto problem = shard_problem(dir, shard_identity(cfg, hash, k)); !problem.empty())
-      throw std::runtime_error(p.string() + ": " + problem + "; run `hypershape generate` on this directory "
-                               "with its config again: it redoes the shard");
-    summaries.push_back(io::read_shard_summary(p.string()));
-    const auto& s = summaries.back();
-    std::int64_t ok = 0, failed = 0, lok = 0, lfailed = 0;
-    for (const auto& sh : s.shapes) {
-      (sh.ok ? ok : failed) += 1;
-      lok += sh.loads_ok;
-      lfailed += sh.loads_failed;
-      if (!sh.ok) failed_shapes.push_back(sh.shape_id);
-    }
-    rep.shapes_ok += ok;
-    rep.shapes_failed += failed;
-    rep.loads_ok += lok;
-    rep.loads_failed += lfailed;
-    shards.push_back({{"file", "shards/" + shard_name(k)},
-                      {"index", k},
-                      {"first_shape", s.header.first_shape},
-                      {"n_shapes", s.header.n_shapes},
-                      {"shapes_ok", ok},
-                      {"shapes_failed", failed},
-                      {"load_cases_converged", lok},
-                      {"load_cases_failed", lfailed},
-                      {"bytes", std::int64_t(fs::file_size(p))},
-                      {"crc32", fmt::format("{:08x}", io::file_crc32(p.string()))}});
+/// One shard's manifest entry; its counts added to `rep`, its failed shapes to `failed_shapes`.
+json shard_entry(std::int64_t k, const fs::path& p, const io::ShardSummary& s, IndexReport& rep,
+                 std::vector<std::int64_t>& failed_shapes) {
+  std::int64_t ok = 0, failed = 0, lok = 0, lfailed = 0;
+  for (const auto& sh : s.shapes) {
+    (sh.ok ? ok : failed) += 1;
+    lok += sh.loads_ok;
+    lfailed += sh.loads_failed;
+    if (!sh.ok) failed_shapes.push_back(sh.shape_id);
   }
-  for (const auto& s : summaries)
-    for (const auto& sh : s.shapes) by_id[sh.shape_id] = &sh;
+  rep.shapes_ok += ok;
+  rep.shapes_failed += failed;
+  rep.loads_ok += lok;
+  rep.loads_failed += lfailed;
+  return {{"file", "shards/" + shard_name(k)},
+          {"index", k},
+          {"first_shape", s.header.first_shape},
+          {"n_shapes", s.header.n_shapes},
+          {"shapes_ok", ok},
+          {"shapes_failed", failed},
+          {"load_cases_converged", lok},
+          {"load_cases_failed", lfailed},
+          {"bytes", std::int64_t(fs::file_size(p))},
+          {"crc32", fmt::format("{:08x}", io::file_crc32(p.string()))}};
+}
 
-  json manifest = {{"format", "hypershape-dataset"},
-                   {"format_version", io::dataset_format_version},
-                   {"name", cfg.name},
-                   {"config_hash", hash},
-                   {"dim", cfg.shapes.dim},
-                   {"n_shapes", cfg.n_shapes},
-                   {"load_cases_per_shape", cfg.loads.count},
-                   {"shard_size", cfg.shard_size},
-                   {"complete", rep.complete()},
-                   {"missing_shards", rep.missing_shards},
-                   {"failed_shapes", failed_shapes},
-                   {"totals",
-                    {{"shapes_ok", rep.shapes_ok},
-                     {"shapes_failed", rep.shapes_failed},
-                     {"load_cases_converged", rep.loads_ok},
-                     {"load_cases_failed", rep.loads_failed}}},
-                   {"shards", shards}};
-  write_json(root / "manifest.json", manifest);
-  if (!rep.complete()) return rep;
+json manifest_json(const config::DatasetConfig& cfg, const std::string& hash, const IndexReport& rep,
+                   const std::vector<std::int64_t>& failed_shapes, json shards) {
+  return {{"format", "hypershape-dataset"},
+          {"format_version", io::dataset_format_version},
+          {"name", cfg.name},
+          {"config_hash", hash},
+          {"dim", cfg.shapes.dim},
+          {"n_shapes", cfg.n_shapes},
+          {"load_cases_per_shape", cfg.loads.count},
+          {"shard_size", cfg.shard_size},
+          {"complete", rep.complete()},
+          {"missing_shards", rep.missing_shards},
+          {"failed_shapes", failed_shapes},
+          {"totals",
+           {{"shapes_ok", rep.shapes_ok},
+            {"shapes_failed", rep.shapes_failed},
+            {"load_cases_converged", rep.loads_ok},
+            {"load_cases_failed", rep.loads_failed}}},
+          {"shards", std::move(shards)}};
+}
 
-  // Splits by shape; failed shapes are in no split.
+using ShapesById = std::map<std::int64_t, const io::ShardSummary::Shape*>;
+
+/// splits.json: the seeded split of the shape ids, failed shapes in none. Returns the splits.
+std::map<std::string, std::vector<std::int64_t>> write_splits(const fs::path& root, const config::DatasetConfig& cfg,
+                                                              const ShapesById& by_id) {
   auto splits = make_splits(cfg);
   json js = {{"seed", cfg.seed},
              {"fractions", {{"train", cfg.split.train}, {"val", cfg.split.val}, {"test", cfg.split.test}}}};
   for (auto& [name, ids] : splits) {
     std::vector<std::int64_t> kept;
     for (auto id : ids)
-      if (by_id.count(id) && by_id[id]->ok) kept.push_back(id);
+      if (by_id.count(id) && by_id.at(id)->ok) kept.push_back(id);
     js[name] = kept;
     ids = kept;
   }
   write_json(root / "splits.json", js);
+  return splits;
+}
 
-  // Normalisation statistics over the train split (fixed order: shape id).
+/// stats.json: normalisation statistics over the train split (fixed order: shape id).
+void write_stats(const fs::path& root, const std::vector<std::int64_t>& train, const ShapesById& by_id) {
   std::map<std::string, std::vector<double>> sums;
-  for (auto id : splits["train"])
-    for (const auto& [field, rows] : by_id[id]->stats) {
+  for (auto id : train)
+    for (const auto& [field, rows] : by_id.at(id)->stats) {
       auto& acc = sums[field];
       acc.resize(rows.size(), 0.0);
       for (std::size_t i = 0; i < rows.size(); ++i) acc[i] += rows[i];
@@ -154,8 +135,43 @@ IndexReport index_dataset(const std::string& dir) {
     }
     stats[field] = {{"count", count}, {"mean", mean}, {"std", stdev}, {"rms", rms}};
   }
-  write_json(root / "stats.json", {{"split", "train"}, {"n_shapes", splits["train"].size()}, {"fields", stats}});
+  write_json(root / "stats.json", {{"split", "train"}, {"n_shapes", train.size()}, {"fields", stats}});
+}
 
+}  // namespace
+
+IndexReport index_dataset(const std::string& dir) {
+  const fs::path root(dir);
+  const fs::path yaml = root / "dataset.yaml";
+  if (!fs::exists(yaml)) throw core::InputError(dir, "", "not a dataset directory (no dataset.yaml)");
+  const config::DatasetConfig cfg = config::parse_dataset_file(yaml.string());
+  // The shards carry the digest of the dataset's meaning (config::canonical_text).
+  const std::string hash = config_hash(cfg);
+  IndexReport rep;
+  rep.shards = (cfg.n_shapes + cfg.shard_size - 1) / cfg.shard_size;
+  json shards = json::array();
+  std::vector<std::int64_t> failed_shapes;
+  std::vector<io::ShardSummary> summaries;
+  summaries.reserve(std::size_t(rep.shards));
+  for (std::int64_t k = 0; k < rep.shards; ++k) {
+    const fs::path p = root / "shards" / shard_name(k);
+    if (!fs::exists(p)) {
+      rep.missing_shards.push_back(k);
+      continue;
+    }
+    if (const auto problem = shard_problem(dir, shard_identity(cfg, hash, k)); !problem.empty())
+      throw std::runtime_error(p.string() + ": " + problem + "; run `hypershape generate` on this directory "
+                               "with its config again: it redoes the shard");
+    summaries.push_back(io::read_shard_summary(p.string()));
+    shards.push_back(shard_entry(k, p, summaries.back(), rep, failed_shapes));
+  }
+  write_json(root / "manifest.json", manifest_json(cfg, hash, rep, failed_shapes, std::move(shards)));
+  if (!rep.complete()) return rep;
+  ShapesById by_id;
+  for (const auto& s : summaries)
+    for (const auto& sh : s.shapes) by_id[sh.shape_id] = &sh;
+  const auto splits = write_splits(root, cfg, by_id);
+  write_stats(root, splits.at("train"), by_id);
   fs::create_directories(root / "xdmf");
   for (std::int64_t k = 0; k < rep.shards; ++k)
     io::write_dataset_xdmf((root / "shards" / shard_name(k)).string(),
