@@ -393,7 +393,15 @@ MeshSampler::MeshSampler(int dim, int degree, std::span<const double> nodes,
                          std::span<const std::int64_t> cells, const geometry::Boundary& boundary,
                          const geometry::SignedDistance& distance, std::span<const double> points)
     : dim_(dim), degree_(degree) {
-  // ---- validation ----
+  validate(nodes, cells, boundary, distance, points);
+  const std::vector<std::size_t> outside = locate(nodes, cells, distance, points);
+  extend_from_boundary(outside, cells, boundary, distance, points);
+}
+
+void MeshSampler::validate(std::span<const double> nodes, std::span<const std::int64_t> cells,
+                           const geometry::Boundary& boundary, const geometry::SignedDistance& distance,
+                           std::span<const double> points) {
+  const int dim = dim_, degree = degree_;
   if (dim != 2 && dim != 3) fail("dimension must be 2 or 3, got " + std::to_string(dim));
   if (degree != 1 && degree != 2) fail("degree must be 1 or 2, got " + std::to_string(degree));
   const std::size_t d = std::size_t(dim);
@@ -405,8 +413,7 @@ MeshSampler::MeshSampler(int dim, int degree, std::span<const double> nodes,
   if (points.size() % d != 0) fail("point array size is not a multiple of the dimension");
   n_nodes_ = nodes.size() / d;
   n_points_ = points.size() / d;
-  if (n_nodes_ >= std::size_t(std::numeric_limits<std::int32_t>::max()))
-    fail("too many nodes for 32-bit stencils");
+  if (n_nodes_ >= std::size_t(std::numeric_limits<std::int32_t>::max())) fail("too many nodes for 32-bit stencils");
   for (const std::int64_t v : cells)
     if (v < 0 || std::size_t(v) >= n_nodes_)
       fail("cell refers to node " + std::to_string(v) + " of " + std::to_string(n_nodes_));
@@ -415,36 +422,32 @@ MeshSampler::MeshSampler(int dim, int degree, std::span<const double> nodes,
   for (const double x : points)
     if (!std::isfinite(x)) fail("non-finite point coordinate");
   if (boundary.dim != dim || distance.dim() != dim)
-    fail("boundary dimension " + std::to_string(boundary.dim) + " != mesh dimension " +
-         std::to_string(dim));
-  if (std::size_t(boundary.n_points()) > n_nodes_)
-    fail("boundary has more points than the mesh has nodes");
-  {
-    double scale = 0;
-    for (const double x : nodes) scale = std::max(scale, std::abs(x));
-    for (std::size_t i = 0; i < boundary.points.size(); ++i)
-      if (!(std::abs(boundary.points[i] - nodes[i]) <= 1e-12 * scale))
-        fail("boundary point " + std::to_string(i / d) + " is not mesh vertex " +
-             std::to_string(i / d));
-  }
-  const std::vector<std::int32_t> fnodes = facet_nodes(dim, degree, cells, npc, boundary);
-  const int fw = degree == 1 ? dim : (dim == 2 ? 3 : 6);
+    fail("boundary dimension " + std::to_string(boundary.dim) + " != mesh dimension " + std::to_string(dim));
+  if (std::size_t(boundary.n_points()) > n_nodes_) fail("boundary has more points than the mesh has nodes");
+  double scale = 0;
+  for (const double x : nodes) scale = std::max(scale, std::abs(x));
+  for (std::size_t i = 0; i < boundary.points.size(); ++i)
+    if (!(std::abs(boundary.points[i] - nodes[i]) <= 1e-12 * scale))
+      fail("boundary point " + std::to_string(i / d) + " is not mesh vertex " + std::to_string(i / d));
+}
 
-  // ---- locate ----
+std::vector<std::size_t> MeshSampler::locate(std::span<const double> nodes, std::span<const std::int64_t> cells,
+                                             const geometry::SignedDistance& distance,
+                                             std::span<const double> points) {
+  const int dim = dim_, npc = width_;
+  const std::size_t d = std::size_t(dim);
   const CellMaps maps(dim, nodes, cells, npc);
   const CellBuckets buckets(dim, nodes, cells, npc, maps);
   inside_.assign(n_points_, 0);
   ids_.assign(n_points_ * std::size_t(width_), 0);
   weights_.assign(n_points_ * std::size_t(width_), 0.0);
   std::vector<std::size_t> outside;  // points that take the closest-point extension
-
   const auto set_cell = [&](std::size_t p, std::size_t c, const double* l) {
     const std::int64_t* v = cells.data() + c * std::size_t(npc);
     std::int32_t* id = ids_.data() + p * std::size_t(width_);
     for (int k = 0; k < npc; ++k) id[k] = std::int32_t(v[k]);
-    cell_basis(dim, degree, l, weights_.data() + p * std::size_t(width_));
+    cell_basis(dim, degree_, l, weights_.data() + p * std::size_t(width_));
   };
-
   std::size_t last = 0;  // previous point's cell: neighbouring points often share it
   bool have_last = false;
   std::array<double, 4> l{}, best_l{};
@@ -481,23 +484,28 @@ MeshSampler::MeshSampler(int dim, int degree, std::span<const double> nodes,
       outside.push_back(p);
     }
   }
+  return outside;
+}
 
-  // ---- closest-point extension ----
+void MeshSampler::extend_from_boundary(const std::vector<std::size_t>& outside, std::span<const std::int64_t> cells,
+                                       const geometry::Boundary& boundary, const geometry::SignedDistance& distance,
+                                       std::span<const double> points) {
+  const int dim = dim_;
+  const std::size_t d = std::size_t(dim);
+  const std::vector<std::int32_t> fnodes = facet_nodes(dim, degree_, cells, width_, boundary);
+  const int fw = degree_ == 1 ? dim : (dim == 2 ? 3 : 6);
   std::vector<double> xo(outside.size() * d);
-  for (std::size_t i = 0; i < outside.size(); ++i)
-    std::copy_n(points.data() + outside[i] * d, d, xo.data() + i * d);
+  for (std::size_t i = 0; i < outside.size(); ++i) std::copy_n(points.data() + outside[i] * d, d, xo.data() + i * d);
   std::vector<geometry::ClosestPoint> hits(outside.size());
   distance.closest(xo, hits);
   // Scale for "at the boundary up to round-off" (bounding box of the boundary).
   double diag2 = 0;
-  {
-    std::array<double, 3> lo{HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
-    for (std::size_t i = 0; i < boundary.points.size(); ++i) {
-      lo[i % d] = std::min(lo[i % d], boundary.points[i]);
-      hi[i % d] = std::max(hi[i % d], boundary.points[i]);
-    }
-    for (std::size_t k = 0; k < d; ++k) diag2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
+  std::array<double, 3> lo{HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  for (std::size_t i = 0; i < boundary.points.size(); ++i) {
+    lo[i % d] = std::min(lo[i % d], boundary.points[i]);
+    hi[i % d] = std::max(hi[i % d], boundary.points[i]);
   }
+  for (std::size_t k = 0; k < d; ++k) diag2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
   const double near_boundary = 1e-10 * std::sqrt(diag2);
   for (std::size_t i = 0; i < outside.size(); ++i) {
     const std::size_t p = outside[i];
@@ -514,7 +522,7 @@ MeshSampler::MeshSampler(int dim, int degree, std::span<const double> nodes,
     std::int32_t* id = ids_.data() + p * std::size_t(width_);
     double* w = weights_.data() + p * std::size_t(width_);
     for (int k = 0; k < width_; ++k) id[k] = fn[k < fw ? k : 0];  // padding: weight 0
-    facet_basis(dim, degree, m, w);
+    facet_basis(dim, degree_, m, w);
   }
 }
 

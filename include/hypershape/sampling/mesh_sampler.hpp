@@ -100,6 +100,16 @@ class MeshSampler {
   std::vector<double> interpolate(std::span<const double> field, int n_comp) const;
 
  private:
+  // The constructor's steps: check the input, locate the points in the cells (the points in no
+  // cell are returned), give those the value at their closest boundary point.
+  void validate(std::span<const double> nodes, std::span<const std::int64_t> cells, const geometry::Boundary& boundary,
+                const geometry::SignedDistance& distance, std::span<const double> points);
+  std::vector<std::size_t> locate(std::span<const double> nodes, std::span<const std::int64_t> cells,
+                                  const geometry::SignedDistance& distance, std::span<const double> points);
+  void extend_from_boundary(const std::vector<std::size_t>& outside, std::span<const std::int64_t> cells,
+                            const geometry::Boundary& boundary, const geometry::SignedDistance& distance,
+                            std::span<const double> points);
+
   int dim_ = 0, degree_ = 0;
   int width_ = 0;  // stencil entries per point: nodes per cell
   std::size_t n_nodes_ = 0, n_points_ = 0, n_snapped_ = 0;
