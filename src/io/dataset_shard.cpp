@@ -300,34 +300,21 @@ ShardSummary read_shard_summary(const std::string& path) {
   out.header = read_header(file.id, path);
   auto& h = out.header;
   h.config_text = read_string(file.id, "config");
-  Id all{check_id(H5Gopen2(file.id, "shapes", H5P_DEFAULT), "shapes"), H5Gclose};
-  H5G_info_t info;
-  check(H5Gget_info(all.id, &info), "shapes");
-  for (hsize_t i = 0; i < info.nlinks; ++i) {
-    char name[64];
-    H5Lget_name_by_idx(all.id, ".", H5_INDEX_NAME, H5_ITER_INC, i, name, sizeof name, H5P_DEFAULT);
-    Id g{check_id(H5Gopen2(all.id, name, H5P_DEFAULT), name), H5Gclose};
+  for_each_group(file.id, "shapes", [&](const char*, hid_t g) {
     ShardSummary::Shape s;
-    s.shape_id = std::int64_t(read_attr_double(g.id, "shape_id"));
-    s.ok = read_attr_string(g.id, "status") == "ok";
+    s.shape_id = std::int64_t(read_attr_double(g, "shape_id"));
+    s.ok = read_attr_string(g, "status") == "ok";
     if (s.ok) {
-      const auto status = read_array<std::int8_t>(g.id, "loads/status", H5T_NATIVE_INT8);
-      for (auto v : status) (v == 1 ? s.loads_ok : s.loads_failed) += 1;
-      if (H5Lexists(g.id, "stats", H5P_DEFAULT) > 0) {
-        Id st{check_id(H5Gopen2(g.id, "stats", H5P_DEFAULT), "stats"), H5Gclose};
-        H5G_info_t si;
-        check(H5Gget_info(st.id, &si), "stats");
-        for (hsize_t k = 0; k < si.nlinks; ++k) {
-          char field[128];
-          H5Lget_name_by_idx(st.id, ".", H5_INDEX_NAME, H5_ITER_INC, k, field, sizeof field, H5P_DEFAULT);
-          s.stats[field] = read_array<double>(st.id, field, H5T_NATIVE_DOUBLE);
-        }
-      }
+      for (auto v : read_array<std::int8_t>(g, "loads/status", H5T_NATIVE_INT8)) (v == 1 ? s.loads_ok : s.loads_failed) += 1;
+      if (H5Lexists(g, "stats", H5P_DEFAULT) > 0)
+        for_each_link(g, "stats", [&](const char* field, hid_t st) {
+          s.stats[field] = read_array<double>(st, field, H5T_NATIVE_DOUBLE);
+        });
     } else {
       s.loads_failed = h.n_loads;
     }
     out.shapes.push_back(std::move(s));
-  }
+  });
   return out;
 }
 

@@ -87,18 +87,26 @@ inline void attr_vector(hid_t obj, const char* name, const std::vector<double>& 
   check(H5Awrite(a.id, H5T_NATIVE_DOUBLE, v.data()), name);
 }
 
-/// Calls fn(name, group id) for every group under `parent`/`path`, in name order.
+/// Calls fn(name, id of the group `parent`/`path`) for every link in that group, in name order.
 template <class Fn>
-void for_each_group(hid_t parent, const char* path, Fn&& fn) {
+void for_each_link(hid_t parent, const char* path, Fn&& fn) {
   Id all{check_id(H5Gopen2(parent, path, H5P_DEFAULT), path), H5Gclose};
   H5G_info_t info;
   check(H5Gget_info(all.id, &info), path);
   for (hsize_t i = 0; i < info.nlinks; ++i) {
-    char name[64];
+    char name[128];
     H5Lget_name_by_idx(all.id, ".", H5_INDEX_NAME, H5_ITER_INC, i, name, sizeof name, H5P_DEFAULT);
-    Id g{check_id(H5Gopen2(all.id, name, H5P_DEFAULT), name), H5Gclose};
-    fn(static_cast<const char*>(name), g.id);
+    fn(static_cast<const char*>(name), all.id);
   }
+}
+
+/// Calls fn(name, group id) for every group under `parent`/`path`, in name order.
+template <class Fn>
+void for_each_group(hid_t parent, const char* path, Fn&& fn) {
+  for_each_link(parent, path, [&](const char* name, hid_t all) {
+    Id g{check_id(H5Gopen2(all, name, H5P_DEFAULT), name), H5Gclose};
+    fn(name, g.id);
+  });
 }
 
 inline Id group(hid_t parent, const std::string& name) {
