@@ -28,4 +28,7 @@ assert v["cells"] > 0 and v["boundary_facets"] > 0, v
 assert abs(v["grid_inside_measure"] / v["measure"] - 1) < 0.2, v
 print(f"{v['boundary_facets']:.0f} boundary facets, {v['cells']:.0f} cells, measure {v['measure']:.3f}")
 PY
+/usr/bin/python3 "$src/scripts/bench_shapes_table.py" "$json" > table.md &&
+  grep -q '^| random2d |' table.md && ok "scripts/bench_shapes_table.py: the README's table from the JSON" ||
+  fail "scripts/bench_shapes_table.py"
 finish

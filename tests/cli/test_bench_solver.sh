@@ -30,4 +30,7 @@ for k in ("mesh", "setup", "factor_first", "target_solve", "residual", "jacobian
     assert t is not None and math.isfinite(t) and t >= 0, (k, t)
 print(f"{v['free_dofs']:.0f} DoFs, alpha {v['alpha']:.5g}, {v['full_newton']:.0f} Newton its")
 PY
+/usr/bin/python3 "$src/scripts/bench_solver_table.py" "$json" > table.md &&
+  grep -q '^| 2 | P1 |' table.md && ok "scripts/bench_solver_table.py: the README's table from the JSON" ||
+  fail "scripts/bench_solver_table.py"
 finish
