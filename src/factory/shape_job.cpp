@@ -1,5 +1,4 @@
 #include "hypershape/factory/shape_job.hpp"
-#include "hypershape/mesh/reference_cell.hpp"
 
 #include <fmt/format.h>
 
@@ -14,6 +13,7 @@
 #include "hypershape/factory/shape_pipeline.hpp"
 #include "hypershape/factory/shape_set.hpp"
 #include "hypershape/geometry/distance.hpp"
+#include "hypershape/mesh/boundary_nodes.hpp"
 #include "hypershape/physics/gaussian_traction.hpp"
 #include "hypershape/physics/problem.hpp"
 #include "hypershape/physics/registry.hpp"
@@ -49,40 +49,6 @@ class Moments {
  private:
   std::map<std::string, std::vector<double>> rows_;
 };
-
-/// Nodes on the boundary facets of each kind: vertices of the facets and, for P2, the midpoints
-/// of their edges (found through the cells' edges, VTK order).
-void boundary_node_masks(const geometry::Boundary& b, const std::vector<int>& dirichlet_facets,
-                         const std::vector<std::int64_t>& cells, int degree, std::int64_t n_nodes,
-                         std::vector<std::int8_t>& dirichlet, std::vector<std::int8_t>& neumann) {
-  const int d = b.dim;
-  dirichlet.assign(std::size_t(n_nodes), 0);
-  neumann.assign(std::size_t(n_nodes), 0);
-  std::map<std::pair<std::int64_t, std::int64_t>, std::int64_t> midpoint;
-  if (degree == 2) {
-    const auto per = std::size_t(mesh::nodes_per_cell(d, 2));
-    const auto edges = mesh::edges(d);
-    for (std::size_t c = 0; c + per <= cells.size(); c += per)
-      for (std::size_t e = 0; e < edges.size(); ++e) {
-        auto a = cells[c + std::size_t(edges[e].first)], z = cells[c + std::size_t(edges[e].second)];
-        midpoint[{std::min(a, z), std::max(a, z)}] = cells[c + std::size_t(d + 1) + e];
-      }
-  }
-  std::vector<std::uint8_t> is_dirichlet(std::size_t(b.n_facets()), 0);
-  for (int f : dirichlet_facets) is_dirichlet[std::size_t(f)] = 1;
-  for (std::int64_t f = 0; f < b.n_facets(); ++f) {
-    auto& mask = is_dirichlet[std::size_t(f)] ? dirichlet : neumann;
-    const auto v = b.facet(f);
-    for (int a = 0; a < d; ++a) mask[std::size_t(v[a])] = 1;
-    if (degree == 2)
-      for (int a = 0; a < d; ++a)
-        for (int z = a + 1; z < d; ++z) {
-          const std::int64_t p = v[a], q = v[z];
-          auto it = midpoint.find({std::min(p, q), std::max(p, q)});
-          if (it != midpoint.end()) mask[std::size_t(it->second)] = 1;
-        }
-  }
-}
 
 std::vector<float> to_float(const std::vector<double>& v) { return {v.begin(), v.end()}; }
 
@@ -296,7 +262,7 @@ void add_mesh(const config::DatasetConfig& cfg, const ShapeSample& shape, const 
   const auto per_cell = std::uint64_t(f.cells.size()) / std::uint64_t(shape.mesh.n_cells());
   arrays.push_back(schema_array("nodes", {U64(f.n_nodes), U64(d)}, f.nodes));
   arrays.push_back(schema_array("cells", {U64(shape.mesh.n_cells()), per_cell}, f.cells));
-  boundary_node_masks(shape.boundary, shape.dirichlet_facets, f.cells, cfg.degree, f.n_nodes, f.dirichlet_mask,
+  mesh::boundary_node_masks(shape.boundary, shape.dirichlet_facets, f.cells, cfg.degree, f.n_nodes, f.dirichlet_mask,
                       f.neumann_mask);
   arrays.push_back(schema_array("dirichlet_mask", {U64(f.n_nodes)}, f.dirichlet_mask));
   arrays.push_back(schema_array("neumann_mask", {U64(f.n_nodes)}, f.neumann_mask));
