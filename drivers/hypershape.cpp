@@ -35,6 +35,7 @@
 #include "hypershape/io/shape_file.hpp"
 #include "hypershape/mesh/gmsh_mesher.hpp"
 #include "hypershape/physics/registry.hpp"
+#include "hypershape/solver/nonlinear.hpp"
 
 using namespace hypershape;
 
@@ -279,10 +280,30 @@ int run(int argc, char** argv) {
   return run_solve(comm, solve_args);  // the one subcommand left
 }
 
+/// What `-help` (PETSc's) prints first: the project's own settings are YAML keys, not PETSc
+/// options; the solver's with their defaults.
+std::string petsc_help_intro() {
+  const solver::SolverOptions d;
+  return fmt::format(
+      "hypershape: hyperelastic finite-element data factory; `hypershape --help` lists its subcommands.\n"
+      "Its own settings are YAML keys of a scene or dataset config, not PETSc options (README: Scenes, "
+      "Datasets); every key is validated.\n"
+      "  solver:  rtol {:g}, max_newton {}, max_increments {}, target_rtol {:g}, control displacement|load "
+      "({}), path_rtol {:g},\n"
+      "           newton_budget {}, fallback {}, branch_switches {}, factor_reuse {}, krylov_budget {} (0: by "
+      "dimension), krylov_rtol {:g}\n"
+      "  petsc:   any PETSc option listed below, without the dash (the command line wins)\n"
+      "  `hypershape effects` lists the effects a scene may use.\n",
+      d.rtol, d.max_newton, d.max_increments, d.target_rtol,
+      d.control == solver::Control::displacement ? "displacement" : "load", d.path_rtol, d.newton_budget,
+      d.fallback, d.branch_switches, d.tangent.reuse, d.tangent.krylov_budget, d.tangent.krylov_rtol);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  core::PetscSession session(&argc, &argv, "hypershape: see `hypershape --help`\n");
+  const std::string help = petsc_help_intro();
+  core::PetscSession session(&argc, &argv, help.c_str());
   int code = 1;
   try {
     code = run(argc, argv);

@@ -50,4 +50,8 @@ good > "$work/ok.yaml"
 if "$bin" solve "$work/ok.yaml" -o "$work/no/such/dir/out.h5" 2>/dev/null; then
   echo "FAIL unwritable output accepted"; fails=$((fails+1)); else echo "ok   unwritable output"; passes=$((passes+1)); fi
 
+# PETSc's -help opens with the project's own settings (YAML keys, the solver's with defaults).
+help=$("$bin" solve -help 2>&1 | head -6)
+grep -q "solver:  rtol 1e-09, max_newton 12" <<<"$help" && grep -q "path_rtol 0.3" <<<"$help" &&
+  ok "-help lists the solver's keys with their defaults" || fail "-help: $help"
 finish
