@@ -263,3 +263,39 @@ TEST_CASE("Springs reject bad keys naming them; a spring alone is a support", "[
   CHECK(s->is_support());
   CHECK_FALSE(s->is_material());
 }
+
+TEST_CASE("A body held by springs alone: the rigid modes are gone, the springs carry the load", "[supports]") {
+  // The disk on an isotropic spring bed over its whole boundary, no Dirichlet condition, under
+  // the seed's Gaussian traction (total force alpha e_y): at equilibrium the spring forces sum
+  // to -alpha e_y (the material's internal forces sum to zero).
+  const double alpha = 5.0;
+  auto make = [](bool spring) {
+    std::vector<physics::EffectPtr> e;
+    e.push_back(physics::make_neo_hookean(500, 0.45));
+    if (spring) e.push_back(effect("spring", MapParams({{"stiffness", 20.0}}), 2));
+    e.push_back(physics::make_gaussian_traction({-1.0, 0.0}, {0.0, 1.0}, 0.2));
+    return std::make_unique<physics::Problem>(PETSC_COMM_WORLD, hstest::disk_mesh(0.1), std::move(e),
+                                              hstest::degree(1));
+  };
+  auto with = make(true), without = make(false);
+  std::unique_ptr<solver::NonlinearSolver> ns;
+  solver::SolverOptions so;
+  so.rtol = 1e-12;
+  ns = std::make_unique<solver::NonlinearSolver>(*with, so);
+  REQUIRE(ns->solve(alpha).converged);
+  // Spring force = residual(with) - residual(without) at the solution (load factor 0).
+  core::VecH r1 = with->create_vector(), r0 = with->create_vector(), ones = with->create_vector();
+  REQUIRE(with->residual(ns->solution(), 0.0, r1));
+  REQUIRE(without->residual(ns->solution(), 0.0, r0));
+  HS_PETSC(VecAXPY(r1, -1.0, r0));
+  double total[2];
+  for (int k = 0; k < 2; ++k) {
+    hstest::interpolate(*with, [k](const double*, double* v) { v[0] = k == 0, v[1] = k == 1; }, ones);
+    PetscScalar s;
+    HS_PETSC(VecDot(r1, ones, &s));
+    total[k] = PetscRealPart(s);
+  }
+  INFO("spring force on the body " << -total[0] << ", " << -total[1]);
+  CHECK(std::abs(total[0]) < 1e-8 * alpha);
+  CHECK(total[1] == Approx(alpha).epsilon(1e-8));  // r_s = K u is the force the body exerts
+}
