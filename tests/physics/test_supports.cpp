@@ -34,13 +34,13 @@ std::unique_ptr<physics::Problem> square_on_spring(bool spring, double kn, doubl
 }
 
 /// A 3D unit cube clamped on x = 1 with an isotropic spring on its face z = 0.
-std::unique_ptr<physics::Problem> cube_on_spring(bool spring, double k) {
+std::unique_ptr<physics::Problem> cube_on_spring(bool spring, double k, int degree) {
   std::vector<physics::EffectPtr> e;
   e.push_back(physics::make_neo_hookean(100, 0.3));
   e.push_back(effect("dirichlet", MapParams({{"box", Vector{1, 0, 0, 1, 1, 1}}}), 3));
   if (spring) e.push_back(effect("spring", MapParams({{"stiffness", k}, {"box", Vector{0, 0, 0, 1, 1, 0}}}), 3));
   return std::make_unique<physics::Problem>(PETSC_COMM_WORLD, mesh::mesh_box(3, 1.0, 0.35), std::move(e),
-                                            hstest::degree(1));
+                                            hstest::degree(degree));
 }
 
 void random_vector(Vec v, unsigned seed, double scale) {
@@ -138,7 +138,10 @@ TEST_CASE("Spring: residual = energy derivative, tangent = finite differences, E
       DYNAMIC_SECTION("2D P" << degree << " k_n " << kn << " k_t " << kt) {
         check_spring_part(*square_on_spring(true, kn, kt, degree), *square_on_spring(false, kn, kt, degree));
       }
-  SECTION("3D P1") { check_spring_part(*cube_on_spring(true, 40.0), *cube_on_spring(false, 40.0)); }
+  for (int degree : {1, 2})
+    DYNAMIC_SECTION("3D P" << degree) {
+      check_spring_part(*cube_on_spring(true, 40.0, degree), *cube_on_spring(false, 40.0, degree));
+    }
 }
 
 TEST_CASE("Spring: the energy of a constant displacement is 1/2 (k_n c_n^2 + k_t c_t^2) |Gamma|", "[supports]") {
