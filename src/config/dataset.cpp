@@ -229,7 +229,7 @@ physics::EffectPtr make_one(const DatasetConfig& c, std::size_t i) {
 
 /// Rejects, before any work, a dataset scene the factory cannot run: unknown effects or keys,
 /// values out of range at either end of a distribution, draws per load case of what is set up
-/// once per shape, no or two materials, no dirichlet_patch, no load scaled by alpha.
+/// once per shape, no or two materials, no dirichlet_patch or a second support, no load scaled by alpha.
 void check_dataset_scene(DatasetConfig& c) {
   const auto& spec = c.scene;
   const int dim = c.shapes.dim;
@@ -238,6 +238,10 @@ void check_dataset_scene(DatasetConfig& c) {
     throw InputError(c.source, "effects", "a dataset needs exactly one dirichlet_patch (its centre is drawn "
                                           "on each shape's boundary, and the mesh conforms to it)");
   const auto& patch = spec.effects[patches[0]];
+  for (auto i : spec.find("dirichlet"))  // (issue 18: several supports per dataset are not done)
+    throw InputError(c.source, spec.effects[i].path,
+                     "a dataset's Dirichlet support is its one dirichlet_patch: the stored dirichlet_mask and "
+                     "dirichlet_distance would not cover this region (use a spring, or a scene)");
   if (patch.params.count("center"))
     throw InputError(c.source, patch.path + ".center", "drawn on each shape's boundary by the factory: leave it out");
   std::vector<physics::EffectPtr> built;

@@ -64,7 +64,7 @@ std::vector<physics::ResolvedEffect> resolve_scene(const config::DatasetConfig& 
   };
   auto placements = [&](std::size_t i, physics::EffectParams& p) {
     const auto& e = cfg.scene.effects[i];
-    if (e.params.count("E_cv") && !e.params.count("E_seed"))  // a modulus field: its modes per shape
+    if ((e.params.count("E_cv") || e.params.count("inclusions")) && !e.params.count("E_seed"))  // a modulus field: its modes per shape
       p.set("E_seed", double(core::stream_key(cfg.seed, core::Purpose::material, {std::uint64_t(shape.shape_id), i}) >> 12));
     if (e.name == "dirichlet_patch") {
       p.set("center", first(shape.dirichlet_center, d));

@@ -33,6 +33,7 @@ void register_builtin() {
     register_pressure();
     register_uniform_traction();
     register_dirichlet_region();
+    register_spring();
   });
 }
 

@@ -120,13 +120,13 @@ std::vector<EffectPtr> build_effects(const std::string& source, const std::vecto
   bool dirichlet = false, scaled_load = false;
   for (const ResolvedEffect& r : effects) {
     EffectPtr e = build_effect(r, dim);
-    if (e->has_energy()) {
+    if (e->is_material()) {
       if (!material.empty())
         r.params.fail("", "a second material (" + material + " is one): one material per body "
                           "(materials by region are not supported)");
       material = r.name;
     }
-    dirichlet = dirichlet || !e->essential_bcs().empty() || r.name.find("dirichlet") != std::string::npos;
+    dirichlet = dirichlet || e->is_support() || r.name.find("dirichlet") != std::string::npos;
     scaled_load = scaled_load || (e->has_load() && e->scaled());
     out.push_back(std::move(e));
   }

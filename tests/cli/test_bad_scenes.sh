@@ -43,6 +43,11 @@ expect unknown_mesh_file 's/{base: circle}/{base: file, file: nowhere.msh}/' 'ge
 expect unknown_base      's/base: circle/base: torus/'             'geometry.base'
 expect bad_degree        's/degree: 1/degree: 3/'                  'mesh.degree'
 expect alpha_and_target  's/{target: 0.3}/{target: 0.3, alpha: 2}/' 'load'
+expect spring_no_stiffness 's/^load:/  spring: {box: [-1, -1, 1, 1]}\nload:/' 'effects.spring.stiffness'
+expect spring_negative   's/^load:/  spring: {normal_stiffness: -2}\nload:/' 'effects.spring.normal_stiffness'
+expect spring_both_forms 's/^load:/  spring: {stiffness: 1, tangential_stiffness: 1}\nload:/' 'effects.spring.stiffness'
+expect inclusions_no_ratio 's/nu: 0.49}/nu: 0.49, inclusions: 2, inclusion_radius: 0.2}/' 'effects.neo_hookean.inclusion_ratio'
+expect inclusions_fraction 's/nu: 0.49}/nu: 0.49, inclusions: 1.5, inclusion_radius: 0.2, inclusion_ratio: 3}/' 'effects.neo_hookean.inclusions'
 expect not_yaml          's/^geometry: {base: circle}/geometry: {base: [circle/' 'YAML'
 
 # An unwritable output directory: rejected before any work.

@@ -163,6 +163,8 @@ bad per_load_E      "effects.neo_hookean.E: drawn per load case" "  neo_hookean:
 bad two_materials   "effects.neo_hookean[1]: a second material" "  neo_hookean: [{E: 500, nu: 0.49}, {E: 50, nu: 0.3}]\n$good_effects"
 bad no_material     "effects: no material"               "$good_effects"
 bad no_patch        "exactly one dirichlet_patch"        "$nh\n  gaussian_traction: {gamma: 0.2}"
+bad extra_dirichlet "effects.dirichlet: a dataset's Dirichlet support" "$nh\n$good_effects\n  dirichlet: {box: [-1, -1, 1, -0.9], components: [1]}"
+bad spring_key      "effects.spring.stiffness"           "$nh\n$good_effects\n  spring: {stiffness: -1}"
 bad patch_center    "effects.dirichlet_patch.center"     "$nh\n  dirichlet_patch: {radius: 0.5, center: [1, 0]}\n  gaussian_traction: {gamma: 0.2}"
 bad only_fixed      "no load scaled by alpha"            "$nh\n  dirichlet_patch: {radius: 0.5}\n  body_force: {value: [0, -1], scale: fixed}"
 bad scale_material  "effects.neo_hookean.scale"          "  neo_hookean: {E: 500, nu: 0.49, scale: fixed}\n$good_effects"

@@ -38,6 +38,12 @@ class Effect {
 
   // ---- stored energy (materials) -------------------------------------------------------------
   virtual bool has_energy() const { return false; }
+  /// Whether the energy is the body's material (a scene has exactly one); an elastic support
+  /// (spring) has an energy but is not a material.
+  virtual bool is_material() const { return has_energy(); }
+  /// Whether the effect restrains the body (a scene needs at least one): essential conditions,
+  /// or a spring foundation.
+  virtual bool is_support() const { return !essential_bcs().empty(); }
   /// Each adds over the local cells; `u` and `r` are local-vector arrays. Each returns false,
   /// leaving partial sums, if some quadrature point has det F <= 0 (not collective).
   virtual bool add_energy(const Space&, const PetscScalar* /*u*/, double& /*energy*/) const {

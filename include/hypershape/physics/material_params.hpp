@@ -37,7 +37,26 @@ class LogNormalField {
   std::vector<double> k_, phase_;  ///< n_modes x dim wave vectors, n_modes phases
 };
 
-/// The modulus field of an effect's keys E_cv, E_length, E_seed; empty when E_cv is absent or 0.
+/// Inclusions: `count` balls (discs in 2D) of radius r whose centres are uniform in the box
+/// [-1, 1]^dim (the normalised shapes' box; balls may overlap or stick out of the body), drawn
+/// from the stream (seed, material, {dim, inclusions}): m(x) = ratio inside any ball, 1 outside.
+/// A pure function of (seed, x), like LogNormalField.
+class InclusionField {
+ public:
+  InclusionField(int dim, int count, double radius, double ratio, std::uint64_t seed);
+  double operator()(const double* x) const;
+  /// count x dim centres, row-major.
+  const std::vector<double>& centers() const { return centers_; }
+
+ private:
+  int dim_;
+  double radius2_, ratio_;
+  std::vector<double> centers_;
+};
+
+/// The modulus field of an effect's keys E_cv, E_length (log-normal), inclusions,
+/// inclusion_radius, inclusion_ratio (inclusions) and E_seed (both): their product; empty when
+/// neither is asked for.
 ScalarFunction modulus_field(const core::Params& p, int dim);
 /// The keys above for a help line.
 std::string modulus_field_help();

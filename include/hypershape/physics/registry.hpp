@@ -15,6 +15,7 @@ void register_linear_elastic();
 void register_pressure();
 void register_uniform_traction();
 void register_dirichlet_region();
+void register_spring();
 
 /// Direct constructors of the built-in effects (tests, benchmarks, programmatic scenes).
 /// Materials; `field` (optional) is a modulus factor m(x) > 0: W(x, F) = m(x) W(F).
@@ -27,6 +28,9 @@ EffectPtr make_linear_elastic(double E, double nu, ScalarFunction field = {});
 EffectPtr make_pressure(double p, const Region& region, int dim);
 /// Uniform dead traction t (dim components) on the region's Neumann facets.
 EffectPtr make_uniform_traction(const std::vector<double>& t, const Region& region);
+/// Elastic foundation on the region's Neumann facets: energy 1/2 int k_n (u.N)^2 + k_t |u - (u.N)N|^2 dS_0
+/// (stiffnesses per unit reference area, >= 0).
+EffectPtr make_spring(double normal_stiffness, double tangential_stiffness, const Region& region);
 EffectPtr make_dirichlet_patch(const std::vector<double>& center, double radius);
 /// t(x) = g phi(x - p_N) / I_N, phi(y) = exp(-|y|^2 / (2 gamma^2)), I_N = int_{Gamma_N} phi;
 /// `direction` is normalised. The load factor (alpha) scales it.
