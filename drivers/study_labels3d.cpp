@@ -37,6 +37,7 @@ int main(int argc, char** argv) {
   app.add_option("--loads-per-shape", o.loads_per_shape, "per-shape costs are shared by this many load cases");
   app.add_flag("--time-target", o.time_target, "also time solve_for_target at the reference's max|u| (the factory's path)");
   app.add_option("--out", out, "JSON results");
+  app.add_option("--write", o.write_dir, "write every solution to DIR/<scene>_<name>.h5 (scripts/check_labels3d_dolfinx.py reads them)");
   try {
     app.parse(int(ours.size()), ours.data());
   } catch (const CLI::ParseError& e) {

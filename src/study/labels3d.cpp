@@ -21,6 +21,7 @@
 #include "hypershape/factory/load_cases.hpp"
 #include "hypershape/geometry/random_shape.hpp"
 #include "hypershape/geometry/surface_remesh.hpp"
+#include "hypershape/io/solution_file.hpp"
 #include "hypershape/mesh/boundary_mesher.hpp"
 #include "hypershape/sampling/mesh_sampler.hpp"
 #include "hypershape/solver/nonlinear.hpp"
@@ -302,6 +303,30 @@ json describe(const Discretisation& d, const Solved& s, int loads_per_shape, dou
           {"seconds_per_load_case", per_load}};
 }
 
+/// The scene as a scene file would say it (for scripts/check_labels3d_dolfinx.py).
+std::string scene_text(const Scene& s, double alpha) {
+  auto v = [](const std::array<double, 3>& a) { return fmt::format("[{:.17g}, {:.17g}, {:.17g}]", a[0], a[1], a[2]); };
+  return fmt::format(
+      "geometry: {{base: file}}\nmesh: {{degree: 2}}\neffects:\n  neo_hookean: {{E: {:.17g}, nu: {:.17g}}}\n"
+      "  dirichlet_patch: {{center: {}, radius: {:.17g}}}\n"
+      "  gaussian_traction: {{center: {}, direction: {}, gamma: {:.17g}}}\nload: {{alpha: {:.17g}}}\n",
+      s.cfg.material.E, s.cfg.material.nu, v(s.p_d), s.r, v(s.lc.center), v(s.lc.direction), s.cfg.loads.gamma, alpha);
+}
+
+void write_solved(const std::string& path, const Scene& scene, const Solved& s, double alpha) {
+  io::SolutionRecord r;
+  r.dim = 3;
+  r.degree = 2;
+  r.n_vertices = s.n_vertices;
+  r.nodes = s.nodes;
+  r.cells = s.cells;
+  r.displacement = s.u;
+  r.scene_text = scene_text(scene, alpha);
+  r.numbers = {{"alpha", alpha}, {"max_displacement", s.max_u}, {"converged", s.converged ? 1.0 : 0.0},
+               {"newton_iterations", double(s.newton)}};
+  io::write_solution(path, r);
+}
+
 }  // namespace
 
 json run(const Options& opt) {
@@ -318,6 +343,9 @@ json run(const Options& opt) {
               {"p_N", scene.lc.center},
               {"g", scene.lc.direction},
               {"loads_per_shape", opt.loads_per_shape},
+              {"E", scene.cfg.material.E},
+              {"nu", scene.cfg.material.nu},
+              {"gamma", scene.cfg.loads.gamma},
               {"results", json::array()}};
   // The reference first (its max|u| is the target of the timed target solves).
   std::vector<Discretisation> order{by_name[opt.reference]};
@@ -330,6 +358,7 @@ json run(const Options& opt) {
     std::cerr << fmt::format("[labels3d] {} {} ...\n", opt.scene, d.name);
     auto s = std::make_unique<Solved>(solve(scene, d, opt.alpha, opt.time_target ? target : std::nullopt));
     if (d.name == opt.reference) target = s->max_u;
+    if (!opt.write_dir.empty()) write_solved(opt.write_dir + "/" + opt.scene + "_" + d.name + ".h5", scene, *s, opt.alpha);
     solved.emplace(d.name, std::move(s));
     const Solved& ref = *solved.at(opt.reference);
     const Solved& me = *solved.at(d.name);

@@ -40,6 +40,7 @@ struct Options {
   std::vector<Discretisation> discretisations;  ///< the reference among them
   int loads_per_shape = 20;    ///< amortises per-shape mesh + set-up over this many load cases
   bool time_target = false;    ///< also time solve_for_target(reference max|u|) (the factory's path)
+  std::string write_dir;       ///< if set: every solution as <dir>/<scene>_<name>.h5 (io::write_solution)
 };
 
 /// Solves every discretisation (one rank) and returns the results as JSON: per discretisation
