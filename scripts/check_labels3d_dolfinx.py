@@ -31,7 +31,8 @@ def main():
     bd.import_dolfinx()
     import h5py
     with h5py.File(args.solution, "r") as f:
-        scene = yaml.safe_load(f.attrs["scene"] if "scene" in f.attrs else f["scene"][()].decode())
+        raw = f["inputs/scene"][()]
+        scene = yaml.safe_load(raw.decode() if isinstance(raw, bytes) else raw)
     hs = bd.read_hypershape(args.solution)
     alpha = float(scene["load"]["alpha"])
     t0 = time.time()

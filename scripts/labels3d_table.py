@@ -2,7 +2,7 @@
 """Tables of the 3D label study (scripts/study_labels3d.sh; docs/ACCURACY.md, "3D labels").
 
     scripts/labels3d_table.py results/labels3d/ball.json results/labels3d/r3d-0.json \
-        [--md results/labels3d/table.md] [--json results/labels3d/table.json]
+        [--md docs/labels3d/table.md] [--json docs/labels3d/table.json]
 
 Per scene: the reference's own error from its ladder (the local sizes at the clamp rim and p_N
 halved twice: ref0.05, ref0.025 and the reference ref0.0125, all compared with the reference),
@@ -62,8 +62,8 @@ def fmt(v, p="{:.2%}"):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("results", nargs="+")
-    ap.add_argument("--md", default="results/labels3d/table.md")
-    ap.add_argument("--json", default="results/labels3d/table.json")
+    ap.add_argument("--md", default="docs/labels3d/table.md")
+    ap.add_argument("--json", default="docs/labels3d/table.json")
     a = ap.parse_args()
     tables, md = {}, []
     for path in a.results:

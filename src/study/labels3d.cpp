@@ -369,6 +369,7 @@ json run(const Options& opt) {
                                                : sample(me, vertices(label));
     const double t_sample = d.label_on.empty() ? 0.0 : core::now_seconds() - t0;
     json r = describe(d, me, opt.loads_per_shape, t_sample);
+    r["label_vertices"] = label.n_vertices;
     if (me.converged && ref.converged) {
       const std::vector<double> u_ref = sample(ref, vertices(label));
       r["error"] = errors(u, u_ref, vertex_volumes(label.shape.mesh), ref.max_u);
