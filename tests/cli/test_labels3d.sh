@@ -2,8 +2,8 @@
 # 3D labels (issue 16 part B, drivers/study_labels3d.cpp) on a small case: the unit ball with the
 # random3d preset's problem at alpha 5. A graded, per-load-case mesh (P2 h 0.3 refined to 0.1 at
 # the clamp rim and 0.05 at p_N), sampled onto the stored h 0.3 mesh's vertices, agrees with a
-# uniformly finer solve (P2 h 0.2) to within the two labels' stated errors against the converged
-# reference (docs/ACCURACY.md, "3D labels": h0.3 rim 0.1 load 0.05 and u0.2 against ref0.0125);
+# uniformly finer solve (P2 h 0.2) to within the two labels' stated errors against the ball's
+# reference (docs/ACCURACY.md, "3D labels");
 # the label is on the stored mesh's vertices; the per-load mesh raises max|u| at the load above
 # the coarse one's. Bad discretisation keys name the allowed ones. ~40 s on a quiet machine (slow).
 set -u
@@ -36,9 +36,11 @@ check(g["per_load_case_mesh"] and g["label_on"] == "coarse", "the graded mesh is
 check(g["label_vertices"] == r["coarse"]["vertices"], f"the label has the stored mesh's {r['coarse']['vertices']} vertices")
 check(g["vertices"] > 2 * r["coarse"]["vertices"], "the per-load mesh is refined")
 check(g["max_u"] > r["coarse"]["max_u"], f"max|u| on the per-load mesh {g['max_u']:.4f} > coarse {r['coarse']['max_u']:.4f}")
-# Stated errors (rel L2, volume-weighted, ball at alpha 5, docs/ACCURACY.md): graded <= 6%,
-# u0.2 <= 6%; so the two agree within 12%. Measured here: 4.3%.
+# Stated errors against the ball's reference (rel L2, volume-weighted, docs/ACCURACY.md "3D
+# labels"): u0.2 8.5%; the graded label lies between rim0.3 (6.0%) and load0.3 (7.9%). The two
+# differ by 4.3% here (measured); 8% (about twice that, below the sum of their errors) fails if
+# the refinement, the sampling onto the stored vertices or the solve breaks.
 e = g["error"]["rel_l2_volume"]
-check(e < 0.12, f"graded vs uniform h 0.2: rel L2 {e:.4f} < 0.12")
+check(e < 0.08, f"graded vs uniform h 0.2: rel L2 {e:.4f} < 0.08")
 sys.exit(1 if fails else 0)
 PY
