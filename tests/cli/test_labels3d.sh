@@ -5,7 +5,8 @@
 # uniformly finer solve (P2 h 0.2) to within the two labels' stated errors against the ball's
 # reference (docs/ACCURACY.md, "3D labels");
 # the label is on the stored mesh's vertices; the per-load mesh raises max|u| at the load above
-# the coarse one's. Bad discretisation keys name the allowed ones. ~40 s on a quiet machine (slow).
+# the coarse one's. Bad discretisation keys name the allowed ones. A sphere scene accepts the
+# datasets' mesh.surface_h / mesh.rim (hypershape solve). ~40 s on a quiet machine (slow).
 set -u
 bin_dir=$(dirname "${HYPERSHAPE_BIN:?}")
 study="$bin_dir/study_labels3d"
@@ -17,6 +18,23 @@ export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
 msg=$("$study" --scene ball --reference a -d a:h=0.3,bogus=1 --out "$work/x.json" 2>&1); code=$?
 [ "$code" -ne 0 ] && grep -q "unknown key 'bogus'" <<<"$msg" && grep -q "allowed: h, surface_h" <<<"$msg" ||
   { echo "FAIL: bad key: exit $code, $msg"; exit 1; }
+
+# A scene accepts the datasets' 3D discretisation keys (mesh.surface_h, mesh.rim): the ball is
+# then meshed as the factory meshes a shape, refined at the rim; a 2D scene rejects them by name.
+scene() {
+  printf 'geometry: {base: %s}\nmesh: %s\neffects:\n  neo_hookean: {E: 500, nu: 0.49}\n  dirichlet_patch: {center: %s, radius: 0.4}\nload: {alpha: 5}\n' "$@"
+}
+vertices() { "${HYPERSHAPE_BIN}" solve "$1" -o "$work/s.h5" 2>&1 | sed -n 's/.*P1: \([0-9]*\) vertices.*/\1/p'; }
+scene sphere "{degree: 1, h: 0.3}" "[1, 0, 0]" > "$work/plain.yaml"
+scene sphere "{degree: 1, h: 0.3, surface_h: 0.3, rim: 0.1}" "[1, 0, 0]" > "$work/rim.yaml"
+n_plain=$(vertices "$work/plain.yaml"); n_rim=$(vertices "$work/rim.yaml")
+[ -n "$n_plain" ] && [ -n "$n_rim" ] && [ "$n_rim" -gt "$n_plain" ] ||
+  { echo "FAIL: scene mesh.rim: $n_plain vertices without, $n_rim with"; exit 1; }
+echo "ok   scene mesh {surface_h, rim}: $n_plain -> $n_rim vertices"
+scene circle "{degree: 1, h: 0.1, rim: 0.05}" "[1, 0]" > "$work/bad.yaml"
+msg=$("${HYPERSHAPE_BIN}" solve "$work/bad.yaml" -o "$work/b.h5" 2>&1) && { echo "FAIL: rim on a 2D scene accepted"; exit 1; }
+grep -q "rim" <<<"$msg" && grep -q "base: sphere" <<<"$msg" || { echo "FAIL: rim on a 2D scene: $msg"; exit 1; }
+echo "ok   scene mesh.rim on a circle rejected: $(tail -1 <<<"$msg")"
 
 if ! "$study" --scene ball --reference fine -d fine:h=0.2 -d coarse:h=0.3 \
      -d graded:h=0.3,rim=0.1,load=0.05,label_on=coarse --out "$work/l.json" 2> "$work/log.txt"; then
