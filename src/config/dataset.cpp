@@ -370,7 +370,24 @@ DatasetConfig parse_dataset_text(const std::string& text, const std::string& sou
                                 "(0.2 or 0.3): with a coarser shapes.h set mesh.h too)", c.shapes.h));
       c.shapes.mesh_h = mh;
     }
-    m.allowed("degree, h (3D: mesh edge length when coarser than shapes.h)");
+    if (m.has("surface_h")) {
+      const double sh = m.number("surface_h");
+      if (c.shapes.dim != 3) m.fail("surface_h", "only for 3D shapes");
+      const double mh = std::max(c.shapes.h, c.shapes.mesh_h);
+      if (!(sh >= c.shapes.h && sh <= mh))
+        m.fail("surface_h", fmt::format("must be in [shapes.h = {:g}, mesh.h = {:g}] (shapes.h: the surface "
+                                        "as drawn, with a coarser interior)", c.shapes.h, mh));
+      c.shapes.surface_h = sh;
+    }
+    if (m.has("rim")) {
+      const double rim = m.number("rim");
+      if (c.shapes.dim != 3) m.fail("rim", "only for 3D shapes (2D boundaries are graded at the patch ends)");
+      if (!(rim > 0 && rim <= std::max(c.shapes.h, c.shapes.mesh_h)))
+        m.fail("rim", "must be in (0, mesh.h] (edge length at the clamp rim)");
+      c.shapes.rim_size = rim;
+    }
+    m.allowed("degree, h (3D: mesh edge length when coarser than shapes.h), surface_h (3D: surface edge "
+              "length, shapes.h keeps it as drawn), rim (3D: edge length at the clamp rim)");
     m.check_all_used();
   }
   {

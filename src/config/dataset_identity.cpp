@@ -25,6 +25,9 @@ std::string shapes_text(const DatasetConfig& c) {
   t += fmt::format("  h: {}\n  mesh_h: {}\n  dirichlet_radius: {}\n  max_turn_deg: {}\n  min_feature_fraction: {}\n",
                    num(s.h), num(s.mesh_h), num(s.dirichlet_radius), num(s.max_turn_deg),
                    num(s.min_feature_fraction));
+  // Written only when set, so that the identity of every config without them is unchanged.
+  if (s.surface_h > 0) t += fmt::format("  surface_h: {}\n", num(s.surface_h));
+  if (s.rim_size > 0) t += fmt::format("  rim_size: {}\n", num(s.rim_size));
   t += fmt::format("  size_grading: {}\n  max_attempts: {}\n  quality: [{}, {}]\n", num(s.size_grading),
                    s.max_attempts, num(s.quality.min_angle_deg), num(s.quality.min_shape));
   return t;

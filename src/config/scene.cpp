@@ -116,7 +116,14 @@ Scene parse_scene_text(const std::string& text, const std::string& source, const
     if (!(s.clamp_refinement > 0 && s.clamp_refinement <= 1))
       mesh.fail("clamp_refinement", "must be in (0, 1] (element size at the patch ends / h)");
   }
-  mesh.allowed("h, degree, clamp_refinement");
+  for (const char* key : {"surface_h", "rim"}) {
+    if (!mesh.has(key)) continue;
+    const double v = mesh.number(key);
+    if (s.dim != 3 || s.base != "sphere") mesh.fail(key, "only for geometry {base: sphere} (the datasets' 3D keys)");
+    if (!(v > 0 && v <= 1)) mesh.fail(key, "must be in (0, 1] (an edge length)");
+    (std::string(key) == "rim" ? s.rim_size : s.surface_h) = v;
+  }
+  mesh.allowed("h, degree, clamp_refinement, surface_h, rim");
   mesh.check_all_used();
 
   if (!top.has("effects")) top.fail("effects", "missing (a mapping of effect names to parameters)");

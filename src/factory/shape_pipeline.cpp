@@ -149,22 +149,24 @@ geometry::Boundary draw_boundary(const ShapeConfig& c, const std::optional<geome
     throw Rejection{"feature", fmt::format("a neck of half-width {:.3g} is thinner than {:.3g} "
                                            "(h / 4: surfaces are resolved uniformly at h)",
                                            thinnest, neck)};
-  if (c.mesh_h <= h) return b;
-  // A simulation mesh coarser than the shape: the accepted surface remeshed at mesh_h (same
-  // clamp sphere), which must pass the same checks; its necks are held to the h-level
-  // threshold, so a neck the coarse surface pinches is redrawn rather than solved on.
-  remesh.target_edge = c.mesh_h;
+  const double surface_h = c.surface_h > 0 ? c.surface_h : c.mesh_h;
+  if (surface_h <= h && c.rim_size <= 0) return b;
+  // A simulation surface other than the drawn one (coarser, or refined at the rim): the accepted
+  // surface remeshed (same clamp sphere), which must pass the same checks; its necks are held to
+  // the h-level threshold, so a neck the coarse surface pinches is redrawn rather than solved on.
+  const std::string what = fmt::format("remeshed at {:g}{}", std::max(surface_h, h),
+                                       c.rim_size > 0 ? fmt::format(" (rim {:g})", c.rim_size) : "");
   try {
-    b = geometry::remesh_surface(b, remesh);
+    b = solve_surface(b, c, out.dirichlet_center);
   } catch (const std::exception& e) {
-    throw Rejection{"boundary", fmt::format("remeshed at mesh.h {:g}: {}", c.mesh_h, e.what())};
+    throw Rejection{"boundary", fmt::format("{}: {}", what, e.what())};
   }
   if (const auto check = geometry::check_boundary(b); !check.ok)
-    throw Rejection{"boundary", fmt::format("remeshed at mesh.h {:g}: {}", c.mesh_h, check.reason)};
+    throw Rejection{"boundary", fmt::format("{}: {}", what, check.reason)};
   const std::vector<double> coarse_in = geometry::inscribed_radii(b);
   if (const double t = *std::min_element(coarse_in.begin(), coarse_in.end()); t < neck)
-    throw Rejection{"feature", fmt::format("remeshed at mesh.h {:g}, a neck of half-width {:.3g} "
-                                           "is thinner than {:.3g}", c.mesh_h, t, neck)};
+    throw Rejection{"feature", fmt::format("{}, a neck of half-width {:.3g} "
+                                           "is thinner than {:.3g}", what, t, neck)};
   return b;
 }
 
@@ -176,6 +178,28 @@ geometry::Boundary load_surface(const std::string& path) {
 }
 
 }  // namespace
+
+geometry::Boundary solve_surface(const geometry::Boundary& drawn, const ShapeConfig& c,
+                                 const std::array<double, 3>& p_d) {
+  const double surface_h = std::max(c.surface_h > 0 ? c.surface_h : c.mesh_h, c.h);
+  if (surface_h <= c.h && c.rim_size <= 0) return drawn;
+  geometry::RemeshOptions remesh;
+  remesh.target_edge = surface_h;
+  if (c.dirichlet_radius > 0) {
+    remesh.clamp_center = p_d;
+    remesh.clamp_radius = c.dirichlet_radius;
+  }
+  if (c.rim_size > 0 && c.dirichlet_radius > 0) {
+    const double rim = c.rim_size, g = c.size_grading, r = c.dirichlet_radius;
+    remesh.size = [rim, g, r, p_d](const std::array<double, 3>& x) {
+      const double d = std::sqrt((x[0] - p_d[0]) * (x[0] - p_d[0]) + (x[1] - p_d[1]) * (x[1] - p_d[1]) +
+                                 (x[2] - p_d[2]) * (x[2] - p_d[2]));
+      return rim + g * std::abs(d - r);
+    };
+    remesh.min_edge = 0.5 * rim;
+  }
+  return geometry::remesh_surface(drawn, remesh);
+}
 
 std::optional<geometry::Boundary> load_base(const ShapeConfig& config) {
   if (config.base == "file") return load_surface(config.base_file);

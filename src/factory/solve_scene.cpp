@@ -8,6 +8,9 @@
 
 #include "hypershape/core/collective.hpp"
 #include "hypershape/core/error.hpp"
+#include "hypershape/factory/shape_pipeline.hpp"
+#include "hypershape/geometry/random_shape.hpp"
+#include "hypershape/mesh/boundary_mesher.hpp"
 #include "hypershape/mesh/gmsh_mesher.hpp"
 #include "hypershape/physics/problem.hpp"
 #include "hypershape/physics/scene.hpp"
@@ -28,6 +31,23 @@ std::optional<mesh::ClampRegion> clamp_of(const std::vector<physics::ResolvedEff
       return c;
     }
   return std::nullopt;
+}
+
+/// The unit ball meshed as the factory meshes a 3D shape (the scene's surface_h / rim keys): a
+/// level-6 icosphere (edges ~0.016) as the drawn surface, factory::solve_surface, mesh_boundary.
+mesh::MeshData ball_as_a_shape(const config::Scene& scene, const std::optional<mesh::ClampRegion>& clamp) {
+  ShapeConfig c;
+  c.dim = 3;
+  c.h = 0;  // the icosphere is only the geometry: always remeshed
+  c.mesh_h = scene.h;
+  c.surface_h = scene.surface_h;
+  c.rim_size = scene.rim_size;
+  c.dirichlet_radius = clamp ? clamp->radius : 0.0;
+  const geometry::Boundary surface = solve_surface(geometry::icosphere(6), c, clamp ? clamp->center : std::array<double, 3>{});
+  mesh::BoundaryMeshOptions mo;
+  mo.h = scene.h;
+  mo.grading = c.size_grading;
+  return mesh::mesh_boundary(surface, mo);
 }
 
 /// Each target of `runs` (or the scene's target or alpha) solved in turn, `runs.repeat` times
@@ -130,9 +150,10 @@ SceneOutcome solve_scene(MPI_Comm comm, const config::Scene& scene_in, const Sce
       mo.clamp_size = scene.h * scene.clamp_refinement;
       auto clamp = clamp_of(resolved, scene.dim);
       core::on_root(comm, [&] {
-        m = scene.base == "polygon" ? mesh::mesh_polygon(scene.polygon, scene.h)
-            : scene.dim == 2        ? mesh::mesh_disk(mo, clamp)
-                                    : mesh::mesh_ball(mo, clamp);
+        m = scene.base == "polygon"                         ? mesh::mesh_polygon(scene.polygon, scene.h)
+            : scene.dim == 2                                ? mesh::mesh_disk(mo, clamp)
+            : scene.surface_h > 0 || scene.rim_size > 0 ? ball_as_a_shape(scene, clamp)
+                                                            : mesh::mesh_ball(mo, clamp);
       });
     }
   }

@@ -82,6 +82,50 @@ VI split_edge_at(Mesh& m, HI h, const Point& x) {
   return vnew;
 }
 
+using Primitive = CGAL::AABB_triangle_primitive<K, std::vector<K::Triangle_3>::const_iterator>;
+using Tree = CGAL::AABB_tree<CGAL::AABB_traits<K, Primitive>>;
+
+std::vector<K::Triangle_3> triangles_of(const Mesh& m) {
+  std::vector<K::Triangle_3> out;
+  out.reserve(m.number_of_faces());
+  for (FI f : m.faces()) {
+    Point p[3];
+    int k = 0;
+    for (VI v : CGAL::vertices_around_face(m.halfedge(f), m)) p[k++] = m.point(v);
+    out.emplace_back(p[0], p[1], p[2]);
+  }
+  return out;
+}
+
+/// RemeshOptions::size: remeshes the faces that want a finer edge, level by level, with
+/// `remesh(faces, t)`; after each level projects every vertex but those `keep` names onto `input`
+/// (the remesher projects onto the surface it was given, here the coarser level's chords) and
+/// calls `after_level()`.
+template <class Remesh, class Keep, class After>
+void refine_locally(Mesh& m, const RemeshOptions& opt, const std::vector<K::Triangle_3>& input, Remesh&& remesh,
+                    Keep&& keep, After&& after_level) {
+  if (!opt.size) return;
+  std::optional<Tree> tree;
+  for (double t = 0.5 * opt.target_edge; t >= opt.min_edge; t *= 0.5) {
+    std::vector<FI> selected;
+    for (FI f : m.faces()) {
+      std::array<double, 3> x{0, 0, 0};
+      for (VI v : CGAL::vertices_around_face(m.halfedge(f), m))
+        for (int k = 0; k < 3; ++k) x[k] += m.point(v)[k] / 3.0;
+      if (opt.size(x) < 1.5 * t) selected.push_back(f);
+    }
+    if (selected.empty()) break;
+    remesh(selected, t);
+    if (!tree) {
+      tree.emplace(input.begin(), input.end());
+      tree->accelerate_distance_queries();
+    }
+    for (VI v : m.vertices())
+      if (!keep(v)) m.point(v) = tree->closest_point(m.point(v));
+    after_level();
+  }
+}
+
 Vector face_normal(const Mesh& m, HI h) {
   const Point& a = m.point(m.source(h));
   const Point& b = m.point(m.target(h));
@@ -90,7 +134,7 @@ Vector face_normal(const Mesh& m, HI h) {
 }
 
 /// Cuts `m` along the sphere |x - c| = r and remeshes it with the cut curve as a constraint.
-void remesh_with_clamp(Mesh& m, const RemeshOptions& opt) {
+void remesh_with_clamp(Mesh& m, const RemeshOptions& opt, const std::vector<K::Triangle_3>& input) {
   const Point c((*opt.clamp_center)[0], (*opt.clamp_center)[1], (*opt.clamp_center)[2]);
   const double r = opt.clamp_radius, h = opt.target_edge;
   const double snap = std::max(1e-3 * h, 1e-8 * r);
@@ -202,6 +246,46 @@ void remesh_with_clamp(Mesh& m, const RemeshOptions& opt) {
       if (dmin - lmax <= r + 2 * h && dmax >= r - 2 * h) band.emplace_back(p[0], p[1], p[2]);
     }
 
+  // Should the remesher have split a constrained edge, the new vertex is at its midpoint (inside
+  // the ball, off the surface-sphere intersection). Move each such vertex to where the input
+  // surface meets the sphere by alternating projections (they converge fast: the two surfaces cross
+  // at a clear angle for a patch centred on the surface). Done after every remesh: a curve
+  // vertex moved only after several levels of refinement would fold the small triangles around it.
+  std::optional<Tree> tree;  // built on first use: normally no vertex needs moving
+  const double tiny = 1e-15 * std::max(r, 1.0);
+  auto snap_curve = [&] {
+    for (VI v : m.vertices()) {
+      bool on_curve = false;
+      for (HI he : CGAL::halfedges_around_target(v, m)) on_curve |= constrained[m.edge(he)];
+      if (!on_curve) continue;
+      const Point x0 = m.point(v);
+      if (std::abs(std::sqrt(CGAL::squared_distance(x0, c)) - r) <= 4 * tiny) {
+        m.point(v) = on_sphere(x0);
+        continue;
+      }
+      std::vector<std::pair<HI, Vector>> normals;
+      for (HI he : CGAL::halfedges_around_target(v, m))
+        if (!m.is_border(he)) normals.emplace_back(he, face_normal(m, he));
+      if (!tree) {
+        tree.emplace(band.begin(), band.end());
+        tree->accelerate_distance_queries();
+      }
+      Point x = on_sphere(x0);
+      for (int it = 0; it < 200; ++it) {
+        const Point xn = on_sphere(tree->closest_point(x));
+        const double step = std::sqrt(CGAL::squared_distance(xn, x));
+        x = xn;
+        if (step <= tiny) break;
+      }
+      m.point(v) = x;
+      for (auto& [he, n0] : normals)
+        if (face_normal(m, he) * n0 <= 0)
+          throw std::runtime_error(
+              "remesh_surface: moving a clamp-curve vertex onto the sphere "
+              "folds a triangle; the target edge is too coarse for the clamp "
+              "radius");
+    }
+  };
   PMP::isotropic_remeshing(faces(m), h, m,
                            CGAL::parameters::number_of_iterations(unsigned(opt.iterations))
                                .edge_is_constrained_map(constrained)
@@ -209,47 +293,28 @@ void remesh_with_clamp(Mesh& m, const RemeshOptions& opt) {
                                .protect_constraints(false)
                                .collapse_constraints(true)
                                .relax_constraints(false));
+  if (n_curve > 0) snap_curve();
+  auto on_curve_vertex = [&](VI v) {
+    for (HI he : CGAL::halfedges_around_target(v, m))
+      if (constrained[m.edge(he)]) return true;
+    return false;
+  };
+  refine_locally(
+      m, opt, input,
+      [&](const std::vector<FI>& selected, double t) {
+        PMP::isotropic_remeshing(selected, t, m,
+                                 CGAL::parameters::number_of_iterations(unsigned(opt.iterations))
+                                     .edge_is_constrained_map(constrained)
+                                     .face_patch_map(patch)
+                                     .protect_constraints(false)
+                                     .collapse_constraints(true)
+                                     .relax_constraints(false));
+      },
+      on_curve_vertex, [&] {
+        if (n_curve > 0) snap_curve();
+      });
   if (n_curve == 0) return;
 
-  // Should the remesher have split a constrained edge, the new vertex is at its midpoint (inside
-  // the ball, off the surface-sphere intersection). Move each such vertex to where the input
-  // surface meets the sphere by alternating projections (they converge fast: the two surfaces cross
-  // at a clear angle for a patch centred on the surface).
-  using Primitive = CGAL::AABB_triangle_primitive<K, std::vector<K::Triangle_3>::const_iterator>;
-  using Tree = CGAL::AABB_tree<CGAL::AABB_traits<K, Primitive>>;
-  std::optional<Tree> tree;  // built on first use: normally no vertex needs moving
-  const double tiny = 1e-15 * std::max(r, 1.0);
-  for (VI v : m.vertices()) {
-    bool on_curve = false;
-    for (HI he : CGAL::halfedges_around_target(v, m)) on_curve |= constrained[m.edge(he)];
-    if (!on_curve) continue;
-    const Point x0 = m.point(v);
-    if (std::abs(std::sqrt(CGAL::squared_distance(x0, c)) - r) <= 4 * tiny) {
-      m.point(v) = on_sphere(x0);
-      continue;
-    }
-    std::vector<std::pair<HI, Vector>> normals;
-    for (HI he : CGAL::halfedges_around_target(v, m))
-      if (!m.is_border(he)) normals.emplace_back(he, face_normal(m, he));
-    if (!tree) {
-      tree.emplace(band.begin(), band.end());
-      tree->accelerate_distance_queries();
-    }
-    Point x = on_sphere(x0);
-    for (int it = 0; it < 200; ++it) {
-      const Point xn = on_sphere(tree->closest_point(x));
-      const double step = std::sqrt(CGAL::squared_distance(xn, x));
-      x = xn;
-      if (step <= tiny) break;
-    }
-    m.point(v) = x;
-    for (auto& [he, n0] : normals)
-      if (face_normal(m, he) * n0 <= 0)
-        throw std::runtime_error(
-            "remesh_surface: moving a clamp-curve vertex onto the sphere "
-            "folds a triangle; the target edge is too coarse for the clamp "
-            "radius");
-  }
 
   // A vertex off the curve on the outer side could sit inside the ball (within the sagitta of a
   // curve edge); push it just outside so that every outer face has a vertex outside the ball.
@@ -284,12 +349,18 @@ Boundary remesh_surface(const Boundary& surface, const RemeshOptions& opt) {
   if (opt.iterations < 1) throw std::invalid_argument("remesh_surface: iterations must be >= 1");
   if (opt.clamp_center && !(opt.clamp_radius > 0 && std::isfinite(opt.clamp_radius)))
     throw std::invalid_argument("remesh_surface: clamp_radius must be positive and finite");
+  if (opt.size && !(opt.min_edge > 0)) throw std::invalid_argument("remesh_surface: min_edge must be positive");
   Mesh m = to_mesh(surface);
-  if (opt.clamp_center)
-    remesh_with_clamp(m, opt);
-  else
-    PMP::isotropic_remeshing(faces(m), opt.target_edge, m,
-                             CGAL::parameters::number_of_iterations(unsigned(opt.iterations)));
+  const std::vector<K::Triangle_3> input = opt.size ? triangles_of(m) : std::vector<K::Triangle_3>{};
+  if (opt.clamp_center) {
+    remesh_with_clamp(m, opt, input);
+  } else {
+    auto remesh = [&](const auto& selected, double t) {
+      PMP::isotropic_remeshing(selected, t, m, CGAL::parameters::number_of_iterations(unsigned(opt.iterations)));
+    };
+    remesh(faces(m), opt.target_edge);
+    refine_locally(m, opt, input, remesh, [](VI) { return false; }, [] {});
+  }
   return to_boundary(m);
 }
 

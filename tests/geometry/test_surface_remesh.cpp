@@ -176,6 +176,59 @@ TEST_CASE("remesh_surface draws the clamp curve with its vertices on the sphere"
   CHECK(area == Approx(cap).epsilon(level == 2 ? 0.05 : 0.02));
 }
 
+TEST_CASE("remesh_surface refines locally, on the input surface, keeping the clamp curve", "[geometry]") {
+  // The unit sphere at 0.3 with the clamp patch of the 3D presets (p_D = (1, 0, 0), r 0.4),
+  // refined to 0.05 at the load point (-1, 0, 0) and at the clamp rim (growth 0.3 per unit).
+  const std::array<double, 3> c = {1, 0, 0}, p_n = {-1, 0, 0};
+  const double r = 0.4;
+  const Boundary in = test::icosphere(5);
+  RemeshOptions opt;
+  opt.target_edge = 0.3;
+  opt.clamp_center = c;
+  opt.clamp_radius = r;
+  const Boundary coarse = remesh_surface(in, opt);
+  opt.size = [&](const std::array<double, 3>& x) {
+    return std::min(0.05 + 0.3 * dist(x, p_n), 0.05 + 0.3 * std::abs(dist(x, c) - r));
+  };
+  opt.min_edge = 0.025;
+  const Boundary out = remesh_surface(in, opt);
+  const auto check = check_boundary(out);
+  INFO(check.reason);
+  REQUIRE(check.ok);
+  CHECK(out.n_points() > 3 * coarse.n_points());
+  // Edges near p_N (within 0.05) and on the rim are near the wanted 0.05: levels 0.15, 0.075,
+  // 0.0375 (a level t remeshes where the size wants < 1.5 t), edges up to 4/3 t; far away they
+  // stay near 0.3.
+  double near_load = 0, far = 0, rim = 0, max_off_sphere = 0;
+  for (std::int64_t f = 0; f < out.n_facets(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const auto a = out.point(out.facet(f)[k]), b = out.point(out.facet(f)[(k + 1) % 3]);
+      const double l = std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+      if (dist(a, p_n) < 0.05) near_load = std::max(near_load, l);
+      if (std::abs(dist(a, c) - r) < 1e-12 && std::abs(dist(b, c) - r) < 1e-12) rim = std::max(rim, l);
+      if (a[1] > 0.9) far = std::max(far, l);
+    }
+  for (std::int64_t i = 0; i < out.n_points(); ++i)
+    max_off_sphere = std::max(max_off_sphere, std::abs(dist(out.point(i), {0, 0, 0}) - 1));
+  CHECK(near_load < 0.1);
+  CHECK(rim < 0.1);
+  CHECK(far > 0.2);
+  // On the input (the level-5 icosphere: edges of 0.03-0.04, off the sphere by up to ~3e-4), not
+  // on the coarse level's chords (0.3: sagitta 0.011).
+  CHECK(max_off_sphere < 5e-4);
+  // The clamp patch is still exactly the facet test, with its area near the cap's, 2 pi 0.08.
+  const auto patch = facets_in_ball(out, c, r);
+  double area = 0;
+  for (int f : patch) area += triangle_area(out, f);
+  CHECK(area == Approx(2 * std::numbers::pi * 0.08).epsilon(0.02));
+  for (std::int64_t f = 0; f < out.n_facets(); ++f) {
+    if (std::binary_search(patch.begin(), patch.end(), int(f))) continue;
+    double dmax = 0;
+    for (int v : out.facet(f)) dmax = std::max(dmax, dist(out.point(v), c));
+    CHECK(dmax > r * (1 + 1e-9));
+  }
+}
+
 TEST_CASE("remesh_surface rejects bad input", "[geometry]") {
   const Boundary in = test::icosphere(1);
   RemeshOptions opt;

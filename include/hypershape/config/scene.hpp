@@ -40,6 +40,11 @@ struct Scene {
   double h = 0.05;
   int degree = 1;
   double clamp_refinement = 0.25;
+  /// 3D sphere: the datasets' discretisation keys (factory::ShapeConfig::surface_h, rim_size).
+  /// With either set, the ball is meshed as the factory meshes a shape (a fine icosphere
+  /// remeshed at surface_h, h when 0, with the clamp curve and the rim refinement, then filled
+  /// up to h) instead of by gmsh's sphere with clamp_refinement.
+  double surface_h = 0, rim_size = 0;
   physics::SceneSpec effects;  ///< in file order; numbers only (no draws in a scene file)
   std::optional<double> alpha, target;
   solver::SolverOptions solver;

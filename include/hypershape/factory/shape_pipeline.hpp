@@ -38,6 +38,13 @@ struct ShapeConfig {
   /// and filled at mesh_h; the stored boundary is that coarser surface, the domain solved on.
   /// Lets P2 run on a coarse mesh without coarsening the family of shapes it is drawn from.
   double mesh_h = 0.0;
+  /// 3D: edge length of the surface solved on and stored (0: mesh_h, as above). shapes.h keeps
+  /// the surface as drawn (its detail in the stored boundary, SDF and point cloud) while the
+  /// interior still grows (size_grading per unit distance) to mesh_h.
+  double surface_h = 0.0;
+  /// 3D: edge length at the clamp rim |x - p_D| = r (0: not refined), growing by size_grading
+  /// per unit distance (geometry::RemeshOptions::size): the rim is where the error lives.
+  double rim_size = 0.0;
   double dirichlet_radius = 0.5;         ///< r of the Dirichlet patch; 0: no patch
   double max_turn_deg = 15.0;            ///< 2D: largest turning angle per boundary edge
   double min_feature_fraction = 0.1;     ///< redraw if a feature is thinner than this * h
@@ -45,6 +52,13 @@ struct ShapeConfig {
   int max_attempts = 20;                 ///< give up (error) after this many redraws
   mesh::QualityGate quality;             ///< defaults per dimension, see quality.hpp
 };
+
+/// 3D: the surface a shape is solved on and stored with: `drawn` (resolved at h) remeshed at
+/// surface_h (mesh_h when 0) with the clamp sphere |x - p_D| = dirichlet_radius, and refined to
+/// rim_size at the rim; `drawn` itself when it is already that (surface_h <= h, no rim). Throws
+/// what geometry::remesh_surface throws. Not collective.
+geometry::Boundary solve_surface(const geometry::Boundary& drawn, const ShapeConfig& c,
+                                 const std::array<double, 3>& p_d);
 
 /// A rejected draw: which attempt, at which stage, and why.
 struct RejectedDraw {

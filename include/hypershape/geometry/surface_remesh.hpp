@@ -2,6 +2,7 @@
 /// Isotropic remeshing of a closed triangle surface, optionally drawing the Dirichlet patch
 /// boundary (the curve where the surface meets a clamp sphere) into the mesh first.
 #include <array>
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -16,6 +17,13 @@ struct RemeshOptions {
   /// Centre p_D of the clamp sphere |x - p_D| = clamp_radius (on or near the surface), if any.
   std::optional<std::array<double, 3>> clamp_center;
   double clamp_radius = 0;  ///< radius r of the clamp sphere (> 0 when clamp_center is set)
+  /// Optional local refinement: the wanted edge length at a point (only where it is below
+  /// target_edge matters). After the uniform remesh, the faces whose centroid wants an edge
+  /// below 1.5 t are remeshed at t, for t = target_edge / 2, / 4, ... while any face wants it
+  /// and t >= min_edge; the vertices this adds (off the clamp curve) are projected onto the
+  /// input surface, so a refined patch of a coarse sphere lies on the sphere, not on its chords.
+  std::function<double(const std::array<double, 3>&)> size;
+  double min_edge = 1e-3;  ///< smallest refinement level (> 0)
 };
 
 /// Remeshes a closed, outward-oriented triangle surface (one that passes check_boundary) into

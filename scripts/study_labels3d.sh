@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# The 3D label study (issue 16 part B, docs/ACCURACY.md "3D labels"): a converged reference on
+# the ball and on Random3D shape 0 (the random3d preset's problem at alpha 5), the ladder that
+# states its error, and the options a dataset could label with.
+#   scripts/study_labels3d.sh [ball|r3d-0 ...]      (default: both; ~15-30 min each on a shared 2-core VM)
+# Output: results/labels3d/<scene>.json, results/labels3d/<scene>_ref*.h5 (for
+# scripts/check_labels3d_dolfinx.py), and the tables (scripts/labels3d_table.py).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+build=${BUILD:-build}
+export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
+scenes=("$@")
+[ ${#scenes[@]} -eq 0 ] && scenes=(ball r3d-0)
+mkdir -p results/labels3d
+for scene in "${scenes[@]}"; do
+  # The reference ladder (local sizes halved at the clamp rim and at p_N; the surface as drawn,
+  # 0.1) and the options. ref0.0125 is the reference; ref0.025 and ref0.05 give its error.
+  "$build/study_labels3d" --scene "$scene" --reference ref0.0125 --write results/labels3d \
+    -d ref0.0125:surface_h=0.1,interior_h=0.3,rim=0.0125,load=0.0125,grading=0.4 \
+    -d ref0.025:surface_h=0.1,interior_h=0.3,rim=0.025,load=0.025,grading=0.4 \
+    -d ref0.05:surface_h=0.1,interior_h=0.3,rim=0.05,load=0.05,grading=0.4 \
+    -d u0.3:h=0.3 -d u0.25:h=0.25 -d u0.2:h=0.2 -d u0.15:h=0.15 \
+    -d rim0.3:h=0.3,rim=0.075 \
+    -d load0.3:h=0.3,load=0.03,label_on=u0.3 \
+    -d s0.1:surface_h=0.1,interior_h=0.3 \
+    -d s0.1rim:surface_h=0.1,interior_h=0.3,rim=0.05 \
+    -d s0.1rimload:surface_h=0.1,interior_h=0.3,rim=0.05,load=0.03,label_on=s0.1rim \
+    --out "results/labels3d/$scene.json" 2>&1 | tee "results/labels3d/$scene.log"
+done
