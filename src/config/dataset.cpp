@@ -17,24 +17,10 @@ namespace hypershape::config {
 
 namespace {
 
-void parse_shapes(const YamlBlock& b, const std::string& base_dir, factory::ShapeConfig& s,
-                  std::int64_t& count, bool scene_given) {
-  // count is read first (it is the first error to report) but a directory family may leave it
-  // out: then it is the number of files.
-  const bool has_count = b.has("count");
-  // The plan, splits and manifest hold every shape id in memory: 10^8 is far past any dataset
-  // that fits a disk (the size estimate refuses much less, see factory/preflight.hpp).
-  if (has_count) count = b.integer("count", 1, 100000000, "shapes");
-  const long dim = b.integer("dim");
-  if (dim != 2 && dim != 3) b.fail("dim", "must be 2 or 3");
-  s.dim = int(dim);
-  s.base = b.text("base");
-  if (s.base != "circle" && s.base != "sphere" && s.base != "file" && s.base != "directory")
-    b.fail("base", "must be circle (2D), sphere (3D), file (3D surface) or directory (3D: one shape "
-                   "per surface file), got '" + s.base + "'");
-  if ((s.base == "circle") != (s.dim == 2))
-    b.fail("base", s.base + " needs dim " + (s.base == "circle" ? "2" : "3") +
-                       " (circle: 2D; sphere, file, directory: 3D)");
+/// shapes.base_file / shapes.base_dir (relative to the config file's directory) and, for a
+/// directory family, the count from its files.
+void parse_base_files(const YamlBlock& b, const std::string& base_dir, factory::ShapeConfig& s, std::int64_t& count,
+                      bool has_count) {
   // Relative paths are relative to the config file's directory.
   auto path_key = [&](const char* key) {
     std::filesystem::path p = b.text(key);
@@ -67,6 +53,10 @@ void parse_shapes(const YamlBlock& b, const std::string& base_dir, factory::Shap
     b.fail("base_dir", "only allowed with base: directory");
   }
   if (!has_count && s.base != "directory") b.fail("count", "missing (a number is required)");
+}
+
+/// shapes.steps: the [sigma, m] pairs of the deformation.
+void parse_steps(const YamlBlock& b, factory::ShapeConfig& s) {
   // A directory family is the files as they are unless steps are given; the other families
   // are made by the steps.
   const YAML::Node steps = b.get("steps");
@@ -91,6 +81,46 @@ void parse_shapes(const YamlBlock& b, const std::string& base_dir, factory::Shap
     if (!(m >= 0.0 && m <= 20.0)) b.fail(key, "m must be in [0, 20]");
     s.deformation.steps.push_back({sigma, m});
   }
+}
+
+/// shapes.quality: the mesh quality gate over its defaults.
+void parse_quality(const YamlBlock& b, factory::ShapeConfig& s) {
+  if (!b.has("quality")) return;
+  YamlBlock q(b.get("quality"), b.file(), join(b.path(), "quality"));
+  s.quality = mesh::QualityGate::defaults(s.dim);
+  if (q.has("min_angle_deg")) {
+    s.quality.min_angle_deg = q.number("min_angle_deg");
+    if (!(s.quality.min_angle_deg >= 0 && s.quality.min_angle_deg < 60))
+      q.fail("min_angle_deg", "must be in [0, 60)");
+  }
+  if (q.has("min_shape")) {
+    s.quality.min_shape = q.number("min_shape");
+    if (!(s.quality.min_shape >= 0 && s.quality.min_shape < 1)) q.fail("min_shape", "must be in [0, 1)");
+  }
+  q.allowed("min_angle_deg, min_shape");
+  q.check_all_used();
+}
+
+void parse_shapes(const YamlBlock& b, const std::string& base_dir, factory::ShapeConfig& s,
+                  std::int64_t& count, bool scene_given) {
+  // count is read first (it is the first error to report) but a directory family may leave it
+  // out: then it is the number of files.
+  const bool has_count = b.has("count");
+  // The plan, splits and manifest hold every shape id in memory: 10^8 is far past any dataset
+  // that fits a disk (the size estimate refuses much less, see factory/preflight.hpp).
+  if (has_count) count = b.integer("count", 1, 100000000, "shapes");
+  const long dim = b.integer("dim");
+  if (dim != 2 && dim != 3) b.fail("dim", "must be 2 or 3");
+  s.dim = int(dim);
+  s.base = b.text("base");
+  if (s.base != "circle" && s.base != "sphere" && s.base != "file" && s.base != "directory")
+    b.fail("base", "must be circle (2D), sphere (3D), file (3D surface) or directory (3D: one shape "
+                   "per surface file), got '" + s.base + "'");
+  if ((s.base == "circle") != (s.dim == 2))
+    b.fail("base", s.base + " needs dim " + (s.base == "circle" ? "2" : "3") +
+                       " (circle: 2D; sphere, file, directory: 3D)");
+  parse_base_files(b, base_dir, s, count, has_count);
+  parse_steps(b, s);
   auto optional_number = [&](const char* key, double& out, double lo, double hi) {
     if (!b.has(key)) return;
     out = b.number(key);
@@ -113,21 +143,7 @@ void parse_shapes(const YamlBlock& b, const std::string& base_dir, factory::Shap
     if (a < 1 || a > 1000) b.fail("max_attempts", "must be in [1, 1000]");
     s.max_attempts = int(a);
   }
-  if (b.has("quality")) {
-    YamlBlock q(b.get("quality"), b.file(), join(b.path(), "quality"));
-    s.quality = mesh::QualityGate::defaults(s.dim);
-    if (q.has("min_angle_deg")) {
-      s.quality.min_angle_deg = q.number("min_angle_deg");
-      if (!(s.quality.min_angle_deg >= 0 && s.quality.min_angle_deg < 60))
-        q.fail("min_angle_deg", "must be in [0, 60)");
-    }
-    if (q.has("min_shape")) {
-      s.quality.min_shape = q.number("min_shape");
-      if (!(s.quality.min_shape >= 0 && s.quality.min_shape < 1)) q.fail("min_shape", "must be in [0, 1)");
-    }
-    q.allowed("min_angle_deg, min_shape");
-    q.check_all_used();
-  }
+  parse_quality(b, s);
   b.allowed("count, dim, base, base_file, base_dir, steps, velocity_unit, nodes_per_sigma, h, dirichlet_radius, "
             "max_turn_deg, min_feature_fraction, max_attempts, quality");
   b.check_all_used();
