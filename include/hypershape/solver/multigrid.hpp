@@ -6,8 +6,11 @@
 ///           modes of the displacement space as its near-null space (MatNullSpaceCreateRigidBody
 ///           on the nodal coordinates, laid out like the solution: clamped nodes removed, P2
 ///           edge nodes included), interpolation reused between the tangents of one problem.
-///  - hypre: CG preconditioned by hypre's BoomerAMG, nodal coarsening on the dim x dim node
-///           blocks, strong threshold 0.5 (FACTS.md: halved its cost at nu = 0.49).
+///  - hypre: CG preconditioned by hypre's BoomerAMG (systems AMG, unknown approach: one
+///           function per displacement component), strong threshold 0.5 (FACTS.md: halved its
+///           cost at nu = 0.49). Nodal coarsening (-amg_pc_hypre_boomeramg_nodal_coarsen 6, and
+///           the rigid-body modes with -amg_pc_hypre_boomeramg_vec_interp_variant 3) is an option:
+///           measured 3.6-4x more preconditioner applications on the ball (multigrid.cpp).
 /// Every default is set only where the options database does not give one (prefix
 /// `<prefix>amg_`: -amg_ksp_type gmres, -amg_pc_gamg_threshold 0.02, ...).
 ///
