@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Group-scaling benchmark (issue 16): one large 3D shape — the unit ball, P2, mesh size H
-# (default 0.12: ~100k unknowns), the 3D presets' patch and load (r 0.4, gamma 0.1), one load
+# (default 0.115: ~110k unknowns), the 3D presets' patch and load (r 0.4, gamma 0.1), one load
 # case to max|u| = TARGET — solved by `hypershape solve` on 1 and on 2 ranks (one solver group),
 # with each linear solver of SOLVERS (default: direct gamg), REPEATS times (default 3), the
 # rank counts interleaved (1, 2, 1, 2, ...) so that a load on the shared machine hits both alike.
@@ -12,7 +12,7 @@
 #   SOLVERS="direct gamg hypre" RANKS="1 2" TARGET=0.3 scripts/bench_groups.sh 0.15 3
 set -euo pipefail
 cd "$(dirname "$0")/.."
-h=${1:-0.12} repeats=${2:-3}
+h=${1:-0.115} repeats=${2:-3}
 solvers=${SOLVERS:-direct gamg} ranks=${RANKS:-1 2} target=${TARGET:-0.3}
 out=${OUT:-results/bench_groups.json} bin=${BIN:-build/hypershape}
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1

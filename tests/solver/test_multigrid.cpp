@@ -33,7 +33,7 @@ std::vector<double> dense_eigenvalues(Mat K) {
   HS_PETSC(MatConvert(K, MATDENSE, MAT_INITIAL_MATRIX, &D));
   PetscInt n;
   HS_PETSC(MatGetSize(D, &n, nullptr));
-  std::vector<PetscScalar> a(std::size_t(n * n)), w(std::size_t(n)), work(std::size_t(8 * n));
+  std::vector<PetscScalar> a(static_cast<std::size_t>(n * n)), w(static_cast<std::size_t>(n)), work(static_cast<std::size_t>(8 * n));
   {
     const PetscScalar* d;
     HS_PETSC(MatDenseGetArrayRead(D, &d));
