@@ -97,6 +97,8 @@ def main():
         for n in a.ranks:
             for k in range(a.repeats):
                 tag = f"{s}-np{n}-{k}"
+                if not os.path.exists(f"{a.work}/{tag}.log"):  # a run cut short: the others stand
+                    continue
                 r = {"solver": s, "ranks": n, "repeat": k, **parse_out(f"{a.work}/{tag}.out")}
                 r["time"] = parse_time(f"{a.work}/{tag}.time")
                 r["events"], r["totals"] = parse_log(f"{a.work}/{tag}.log")
@@ -124,11 +126,13 @@ def main():
     for s in a.solvers:
         for n in a.ranks:
             sel = [r for r in runs if r["solver"] == s and r["ranks"] == n]
+            if not sel:
+                raise SystemExit(f"no finished run of {s} on {n} ranks")
             med[(s, n)] = {"solve_s": statistics.median(r["seconds_solve"] for r in sel),
                            "wall_s": statistics.median(r["time"]["wall"] for r in sel),
                            "solve_runs": [r["seconds_solve"] for r in sel], "first": sel[0]}
     print(f"\nGroup scaling: unit ball P2 h {a.h}, {runs[0]['dofs']} unknowns, target max|u| {a.target}, "
-          f"medians of {a.repeats} (1- and 2-rank runs interleaved; the machine was shared)")
+          f"medians of up to {a.repeats} (1- and 2-rank runs interleaved; the machine was shared)")
     print(f"{'solver':8} {'ranks':>5} {'solve s':>9} {'runs':>24} {'speed-up':>8} {'Newton':>6} {'factor.':>7} "
           f"{'MatMult':>7} {'AMG set':>7} {'msgs':>8} {'MiB sent':>8} {'ghosts/rank':>11} {'max|du|':>9}")
     table = []

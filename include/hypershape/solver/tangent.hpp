@@ -62,7 +62,7 @@ struct TangentOptions {
   /// The linear solver of the tangent (multigrid.hpp). `automatic`: AMG (gamg) for 3D problems
   /// of at least `auto_dofs` unknowns, the direct LDL^T otherwise.
   LinearSolver linear = LinearSolver::automatic;
-  std::int64_t auto_dofs = 100000;
+  std::int64_t auto_dofs = 150000;
 };
 
 class Tangent {
