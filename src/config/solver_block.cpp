@@ -30,8 +30,17 @@ void parse_solver_block(const YamlBlock& sol, solver::SolverOptions& s) {
   if (sol.has("fallback")) s.fallback = sol.boolean("fallback");
   if (sol.has("branch_switches")) s.branch_switches = int(sol.integer("branch_switches"));
   if (s.branch_switches < 0 || s.branch_switches > 10) sol.fail("branch_switches", "must be in [0, 10]");
+  if (sol.has("linear")) {
+    const auto l = solver::linear_solver_from_string(sol.text("linear"));
+    if (!l) sol.fail("linear", "must be auto, direct, gamg or hypre");
+    s.tangent.linear = *l;
+  }
+  if (sol.has("linear_auto_dofs")) s.tangent.auto_dofs = sol.integer("linear_auto_dofs");
+  if (s.tangent.auto_dofs < 1) sol.fail("linear_auto_dofs", "must be >= 1 (unknowns from which auto picks gamg in 3D)");
+  if (s.tangent.reuse && (s.tangent.linear == solver::LinearSolver::gamg || s.tangent.linear == solver::LinearSolver::hypre))
+    sol.fail("factor_reuse", "must be false with linear: gamg or hypre (a kept factor is the direct solver's)");
   sol.allowed("rtol, max_newton, factor_reuse, krylov_budget, krylov_rtol, max_increments, target_rtol, control, path_rtol, newton_budget, fallback, "
-              "branch_switches");
+              "branch_switches, linear, linear_auto_dofs");
   sol.check_all_used();
 }
 

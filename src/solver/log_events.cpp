@@ -17,6 +17,8 @@ const Events& events() {
     HS_PETSC(PetscLogEventRegister("HSCorrector", cls, &r.corrector));
     HS_PETSC(PetscLogEventRegister("HSBranchSwitch", cls, &r.branch_switch));
     HS_PETSC(PetscLogEventRegister("HSLoadControl", cls, &r.load_control));
+    HS_PETSC(PetscLogEventRegister("HSAMGSetup", cls, &r.multigrid_setup));
+    HS_PETSC(PetscLogEventRegister("HSStability", cls, &r.stability));
     return r;
   }();
   return e;

@@ -2,14 +2,15 @@
 /// PETSc log events of the nonlinear solver's pieces, so that -log_view explains a load case:
 /// HSTangentAsm (tangent assemblies), HSFactor (numeric factorisations, symbolic included on
 /// the first), HSFactorSolve (direct solves with a factor), HSKrylov (Newton-Krylov solves),
-/// HSPredictor / HSCorrector (the displacement-controlled path), HSBranchSwitch, HSLoadControl.
+/// HSPredictor / HSCorrector (the displacement-controlled path), HSBranchSwitch, HSLoadControl,
+/// HSAMGSetup (multigrid set-ups of a tangent), HSStability (the multigrid kind's LOBPCG check).
 #include <petsclog.h>
 
 namespace hypershape::solver {
 
 struct Events {
   PetscLogEvent tangent_assembly, factorisation, factor_solve, krylov, predictor, corrector,
-      branch_switch, load_control;
+      branch_switch, load_control, multigrid_setup, stability;
 };
 
 /// Registered on first use (PETSc must be initialised). Not collective.

@@ -319,6 +319,14 @@ bool NonlinearSolver::factorise_here() {
   return true;
 }
 
+bool NonlinearSolver::check_stability_here() {
+  negative_pivots_ = -1;
+  if (!tangent_->assemble(u_)) return false;
+  pseudo_random_vector(v_);
+  negative_pivots_ = tangent_->stability(v_);
+  return negative_pivots_ >= 0;
+}
+
 double NonlinearSolver::control_direction(Vec u, Vec fallback, Vec c) {
   DM dm = problem_.dm();
   const int dim = problem_.space().dim();
@@ -395,6 +403,11 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
         why = "tangent factorisation at the final state failed";
         return false;
       }
+      // With multigrid no factor gives the inertia: the smallest eigenvalue's sign does.
+      if (rtol <= opt_.rtol && tangent_->multigrid() && !check_stability_here()) {
+        why = "tangent at the final state could not be formed or factorised";
+        return false;
+      }
       return true;
     }
     if (k == opt_.max_newton) {
@@ -443,9 +456,9 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
   }
 }
 
-double NonlinearSolver::softest_mode() {
-  // Start: a pseudo-random vector keyed by the canonical node numbers (the same on any rank
-  // count), so that no mode is missing from it by symmetry.
+void NonlinearSolver::pseudo_random_vector(Vec v) {
+  // Keyed by the canonical node numbers (the same on any rank count), so that no mode is
+  // missing from it by symmetry.
   DM dm = problem_.dm();
   const int dim = problem_.space().dim();
   Vec xl;
@@ -462,8 +475,12 @@ double NonlinearSolver::softest_mode() {
         x[n.offset + i] = double(h >> 11) / double(1ull << 53) - 0.5;
       }
   }
-  HS_PETSC(DMLocalToGlobal(dm, xl, INSERT_VALUES, v_));
+  HS_PETSC(DMLocalToGlobal(dm, xl, INSERT_VALUES, v));
   HS_PETSC(DMRestoreLocalVector(dm, &xl));
+}
+
+double NonlinearSolver::softest_mode() {
+  pseudo_random_vector(v_);
   for (int k = 0; k < 8; ++k) {  // K is factored (factorise_here): 8 back-substitutions
     PetscReal n;
     HS_PETSC(VecNormalize(v_, &n));

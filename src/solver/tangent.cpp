@@ -3,6 +3,7 @@
 #include <petscmat.h>
 
 #include <algorithm>
+#include <stdexcept>
 #include <string>
 
 #include "hypershape/core/error.hpp"
@@ -39,6 +40,15 @@ Tangent::Tangent(const physics::Problem& problem, const TangentOptions& opt, con
   if (opt_.krylov_budget <= 0) opt_.krylov_budget = problem.space().dim() == 2 ? 25 : 60;
   forcing_ = opt_.krylov_rtol;
   J_ = problem.create_matrix();
+  // A kept factor is the direct solver's: with factor reuse, auto means direct.
+  linear_ = opt_.reuse && opt_.linear == LinearSolver::automatic
+                ? LinearSolver::direct
+                : resolve_linear_solver(opt_.linear, problem.space().dim(), problem.space().n_dofs_global(), opt_.auto_dofs);
+  if (multigrid()) {
+    if (opt_.reuse) throw std::logic_error("a kept factor (reuse) and a multigrid solver exclude each other");
+    set_rigid_body_near_null_space(problem, J_);
+    amg_ = make_multigrid_ksp(problem.comm(), linear_, prefix);
+  }
   work_ = std::make_unique<LdltFactor>(problem, prefix);
   krylov_ = make_factor_preconditioned_gmres(problem.comm(), this, apply_shell, "kept LDL^T factor of an earlier tangent");
   HS_PETSC(KSPSetOptionsPrefix(krylov_, (prefix + "tangent_").c_str()));
@@ -63,12 +73,14 @@ PetscErrorCode Tangent::apply_shell(PC pc, Vec x, Vec y) {
 bool Tangent::assemble(Vec u) {
   LogEvent e(events().tangent_assembly);
   current_ = false;
+  amg_current_ = false;
   ++n_.tangent_assemblies;
   return problem_.jacobian(u, J_);
 }
 
 void Tangent::shift(double mu) {
   current_ = false;
+  amg_current_ = false;
   HS_PETSC(MatShift(J_, mu));
 }
 
@@ -129,7 +141,53 @@ bool Tangent::krylov_solve(Vec b, Vec x, bool guess, int max_its, bool& converge
   return usable(r);
 }
 
+void Tangent::set_up_multigrid() {
+  if (amg_current_) return;
+  LogEvent e(events().multigrid_setup);
+  HS_PETSC(KSPSetOperators(amg_, J_, J_));
+  HS_PETSC(KSPSetUp(amg_));
+  amg_current_ = true;
+}
+
+bool Tangent::multigrid_solve(Vec b, Vec x, bool guess) {
+  set_up_multigrid();
+  LogEvent e(events().krylov);
+  PetscReal bn;
+  HS_PETSC(VecNorm(b, NORM_2, &bn));
+  HS_PETSC(KSPSetTolerances(amg_, 1e-30, forcing_ * bn, PETSC_DEFAULT, 1000));
+  HS_PETSC(KSPSetInitialGuessNonzero(amg_, guess ? PETSC_TRUE : PETSC_FALSE));
+  HS_PETSC(KSPSolve(amg_, b, x));
+  PetscInt its;
+  KSPConvergedReason r;
+  HS_PETSC(KSPGetIterationNumber(amg_, &its));
+  HS_PETSC(KSPGetConvergedReason(amg_, &r));
+  n_.krylov_iterations += its;
+  if (r > 0) return true;
+  // CG stops on negative curvature (an indefinite tangent past a limit point) or stagnates:
+  // this tangent is factorised instead, so the path goes on as the direct Newton's would.
+  HS_PETSC(PetscInfo(amg_.get(), "multigrid solve failed (%s after %d its): factorising\n", KSPConvergedReasons[r], int(its)));
+  if (!current_ && !factorise()) return false;
+  return apply_factor(b, x);
+}
+
+int Tangent::stability(Vec start) {
+  set_up_multigrid();
+  LogEvent e(events().stability);
+  PC pc;
+  HS_PETSC(KSPGetPC(amg_, &pc));
+  // One digit of the smallest eigenvalue settles its sign; 100 iterations of LOBPCG cost about
+  // as much as two CG solves with the same AMG.
+  const EigenEstimate est = smallest_eigenvalue(J_, pc, start, 0.1, 100);
+  n_.krylov_iterations += est.iterations;
+  HS_PETSC(PetscInfo(amg_.get(), "stability: smallest eigenvalue %g (residual %g, %d LOBPCG its)%s\n", est.value,
+                     est.residual, est.iterations, est.settled ? "" : ": not settled, factorising"));
+  if (est.settled) return est.value < 0 ? 1 : 0;
+  if (!factorise()) return -1;
+  return factor().negative_eigenvalues();
+}
+
 bool Tangent::solve(Vec b, Vec x, bool guess) {
+  if (multigrid()) return multigrid_solve(b, x, guess);
   if (!opt_.reuse) {  // a direct Newton: factorise every assembled tangent
     if (!current_ && !factorise()) return false;
     return apply_factor(b, x);

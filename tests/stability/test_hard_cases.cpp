@@ -239,6 +239,49 @@ void near_incompressible(double h) {
     }
 }
 
+/// Solver options with the tangent's linear solver `linear` (direct, gamg, hypre).
+solver::SolverOptions options_with(solver::LinearSolver linear) {
+  solver::SolverOptions opt;
+  opt.tangent.linear = linear;
+  return opt;
+}
+
+std::string suffix(solver::LinearSolver linear) {
+  return linear == solver::LinearSolver::direct ? "" : std::string(" (") + solver::to_string(linear) + ")";
+}
+
+/// The ball to max|u| 0.5, 0.8, 1 (P1, and P2 if `p2`), gamma 0.1.
+void large_loads_ball(Table& table, double h_ball, bool p2, solver::LinearSolver linear) {
+  for (int degree : {1, 2}) {
+    if (degree == 2 && !p2) continue;
+    SceneSpec s;
+    s.dim = 3;
+    s.h = h_ball;
+    s.gamma = 0.1;  // the paper's 3D width
+    auto p = make_problem(s, degree);
+    const auto opt = options_with(linear);
+    solver::NonlinearSolver ns(*p, opt);
+    for (double target : {0.5, 0.8, 1.0})
+      run_target(table, ns, opt, "ball P" + std::to_string(degree) + " target " + fmt_num(target) + suffix(linear),
+                 target, true);
+  }
+}
+
+/// The ball on a clamp of radius 0.1 (P1), to max|u| 0.3 and 1.
+void tiny_clamp_ball(Table& table, double h_ball, solver::LinearSolver linear) {
+  SceneSpec s;
+  s.dim = 3;
+  s.h = h_ball;
+  s.clamp_radius = 0.1;
+  s.clamp_size = 0.05;
+  s.gamma = 0.1;
+  auto p = make_problem(s, 1);
+  const auto opt = options_with(linear);
+  solver::NonlinearSolver ns(*p, opt);
+  for (double target : {0.3, 1.0})
+    run_target(table, ns, opt, "ball P1 r 0.1 target " + fmt_num(target) + suffix(linear), target, true);
+}
+
 void large_loads(double h_disk, double h_ball, bool ball_p2) {
   Table table("large displacements: unit disk h " + fmt_num(h_disk) + ", unit ball h " +
               fmt_num(h_ball));
@@ -252,19 +295,7 @@ void large_loads(double h_disk, double h_ball, bool ball_p2) {
       run_target(table, ns, opt, "disk P" + std::to_string(degree) + " target " + fmt_num(target),
                  target, true);
   }
-  for (int degree : {1, 2}) {
-    if (degree == 2 && !ball_p2) continue;
-    SceneSpec s;
-    s.dim = 3;
-    s.h = h_ball;
-    s.gamma = 0.1;  // the paper's 3D width
-    auto p = make_problem(s, degree);
-    solver::SolverOptions opt;
-    solver::NonlinearSolver ns(*p, opt);
-    for (double target : {0.5, 0.8, 1.0})
-      run_target(table, ns, opt, "ball P" + std::to_string(degree) + " target " + fmt_num(target),
-                 target, true);
-  }
+  large_loads_ball(table, h_ball, ball_p2, solver::LinearSolver::direct);
 }
 
 void concentrated_loads(double h, const std::vector<int>& degrees) {
@@ -302,17 +333,7 @@ void tiny_clamp(double h, double h_ball) {
                  "disk P" + std::to_string(degree) + " r 0.05 target " + fmt_num(target), target,
                  true);
   }
-  SceneSpec s;
-  s.dim = 3;
-  s.h = h_ball;
-  s.clamp_radius = 0.1;
-  s.clamp_size = 0.05;
-  s.gamma = 0.1;
-  auto p = make_problem(s, 1);
-  solver::SolverOptions opt;
-  solver::NonlinearSolver ns(*p, opt);
-  for (double target : {0.3, 1.0})
-    run_target(table, ns, opt, "ball P1 r 0.1 target " + fmt_num(target), target, true);
+  tiny_clamp_ball(table, h_ball, solver::LinearSolver::direct);
 }
 
 /// The traction centred just outside the clamp (|p_N - p_D| = r + 0.1 on the circle), pulling
@@ -340,8 +361,8 @@ void load_next_to_clamp(double h) {
 
 /// The unit ball flattened to thickness 0.3 (z scaled by 0.15): a plate, loaded out of plane
 /// (bending, large rotation) and in plane.
-void flat_body(double h) {
-  Table table("nearly flat 3D body: ball scaled by 0.15 in z, h " + fmt_num(h));
+void flat_body(double h, solver::LinearSolver linear = solver::LinearSolver::direct) {
+  Table table("nearly flat 3D body: ball scaled by 0.15 in z, h " + fmt_num(h) + suffix(linear));
   for (const auto& [dir_name, g] :
        {std::pair{"out-of-plane", std::vector<double>{0, 0, 1}}, {"in-plane", {0, 1, 0}}}) {
     SceneSpec s;
@@ -352,7 +373,7 @@ void flat_body(double h) {
     s.g = g;
     auto p = make_problem(s, 1);
     REQUIRE(p->min_det_f(p->create_vector()) > 0);
-    solver::SolverOptions opt;
+    const auto opt = options_with(linear);
     solver::NonlinearSolver ns(*p, opt);
     for (double target : {0.3, 0.8, 1.0})
       run_target(table, ns, opt, std::string("flat ball P1 ") + dir_name + " target " + fmt_num(target),
@@ -532,6 +553,15 @@ TEST_CASE("Hard case: traction next to the Dirichlet patch", "[stability]") {
 }
 
 TEST_CASE("Hard case: nearly flat 3D body", "[stability]") { flat_body(0.25); }
+
+TEST_CASE("Hard case: the 3D cases with the multigrid solvers (GAMG, BoomerAMG)", "[stability]") {
+  for (auto linear : {solver::LinearSolver::gamg, solver::LinearSolver::hypre}) {
+    Table table(std::string("3D hard cases, ") + solver::to_string(linear) + ": large loads, tiny clamp");
+    large_loads_ball(table, 0.25, false, linear);
+    tiny_clamp_ball(table, 0.25, linear);
+  }
+  flat_body(0.25, solver::LinearSolver::gamg);
+}
 
 TEST_CASE("Hard case: thin necks and concave corners of OODRandom2D draws", "[stability]") {
   random_shapes({{53, true, 0.0038}, {57, true, 0.0038}, {28, false, 0.0025}, {39, false, 0.0025}},

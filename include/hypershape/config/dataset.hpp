@@ -49,7 +49,8 @@
 /// split: {train: 0.8, val: 0.1, test: 0.1}   # by shape, deterministic
 /// output: {shard_size: 8}         # shapes per HDF5 shard (the unit of work and of resume)
 /// solver: {rtol: 1e-9, max_newton: 12, factor_reuse: false, krylov_budget: 0, krylov_rtol: 1e-3, max_increments: 64, target_rtol: 1e-3,
-///          control: displacement, path_rtol: 0.3, newton_budget: 200, fallback: false}   # the defaults
+///          control: displacement, path_rtol: 0.3, newton_budget: 200, fallback: false,
+///          linear: auto, linear_auto_dofs: 150000}   # the defaults; linear: auto | direct | gamg | hypre
 /// petsc: {snes_monitor: ""}       # any PETSc option; the command line wins
 /// ```
 /// Every key is checked; errors name the file and the key path (core::InputError).

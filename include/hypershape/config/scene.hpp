@@ -11,7 +11,7 @@
 ///   dirichlet_patch: {center: [1, 0], radius: 0.5}
 ///   gaussian_traction: {center: [-1, 0], direction: [0, 1], gamma: 0.2}
 /// load: {target: 0.3}                 # or {alpha: 10}
-/// solver: {rtol: 1e-9, max_newton: 12, target_rtol: 1e-3, control: displacement}
+/// solver: {rtol: 1e-9, max_newton: 12, target_rtol: 1e-3, control: displacement, linear: auto}
 /// petsc: {snes_monitor: ""}           # any PETSc options, without the leading dash
 /// ```
 /// Every key is checked: unknown keys, wrong types and out-of-range values throw

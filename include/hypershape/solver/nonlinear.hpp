@@ -183,6 +183,11 @@ class NonlinearSolver {
   /// Assembles and factorises K(u_) at a converged state: its inertia, exact, is the stability
   /// check (negative_pivots_). False if the tangent cannot be formed or factorised.
   bool factorise_here();
+  /// Multigrid: assembles K(u_) at a converged state and checks that it is positive definite
+  /// (Tangent::stability) into negative_pivots_. False if it cannot be formed or factorised.
+  bool check_stability_here();
+  /// A pseudo-random vector keyed by canonical node numbers (the same on any rank count) in v.
+  void pseudo_random_vector(Vec v);
   /// All linear-algebra work so far (the path's tangent and the SNES's).
   LinearCounters linear_counters() const;
   /// After a failed path: leaves the state the path ended in (unstable, or where increments

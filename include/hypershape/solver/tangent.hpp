@@ -32,6 +32,7 @@
 #include "hypershape/core/petsc_handle.hpp"
 #include "hypershape/physics/problem.hpp"
 #include "hypershape/solver/ldlt.hpp"
+#include "hypershape/solver/multigrid.hpp"
 
 namespace hypershape::solver {
 
@@ -58,6 +59,10 @@ struct TangentOptions {
   int krylov_budget = 0;
   /// Relative tolerance of each Krylov solve (the inexact Newton forcing term).
   double krylov_rtol = 1e-3;
+  /// The linear solver of the tangent (multigrid.hpp). `automatic`: AMG (gamg) for 3D problems
+  /// of at least `auto_dofs` unknowns, the direct LDL^T otherwise.
+  LinearSolver linear = LinearSolver::automatic;
+  std::int64_t auto_dofs = 150000;
 };
 
 class Tangent {
@@ -86,6 +91,15 @@ class Tangent {
   bool apply_factor(Vec x, Vec y);
   /// Inertia of the factor in use; -1 unknown. Exact for K(u) only if factor_is_current().
   int negative_eigenvalues() const;
+  /// Multigrid kind: whether the assembled tangent is positive definite, for the stability
+  /// check of a converged state without its factorisation: LOBPCG preconditioned by the AMG
+  /// from `start` (overwritten), and, where that does not settle the sign, a factorisation.
+  /// Returns 0 (positive definite), >= 1 (indefinite; exact count only if factorised) or -1
+  /// (the factorisation failed). Collective.
+  int stability(Vec start);
+  /// The tangent is solved by AMG-preconditioned Krylov (not by a factorisation).
+  bool multigrid() const { return linear_ == LinearSolver::gamg || linear_ == LinearSolver::hypre; }
+  LinearSolver linear_solver() const { return linear_; }
   /// The factor in use is of the assembled tangent (no assembly since the factorisation).
   bool factor_is_current() const { return current_; }
   Mat matrix() const { return J_.get(); }
@@ -97,6 +111,11 @@ class Tangent {
  private:
   LdltFactor& factor() const { return use_rest_ ? *rest_ : *work_; }
   bool krylov_solve(Vec b, Vec x, bool guess, int max_its, bool& converged);
+  /// Multigrid kind: the AMG of the assembled tangent, set up once per assembly.
+  void set_up_multigrid();
+  /// Multigrid kind: CG + AMG to the forcing term; a factorisation of this tangent where the
+  /// Krylov solve fails (an indefinite tangent near a limit point; counted as such).
+  bool multigrid_solve(Vec b, Vec x, bool guess);
   static PetscErrorCode apply_shell(PC pc, Vec x, Vec y);
 
   const physics::Problem& problem_;
@@ -106,6 +125,9 @@ class Tangent {
   core::MatH J0_;       ///< K(0), 2D
   std::unique_ptr<LdltFactor> work_, rest_;  ///< of the current tangent at factorise(); of K(0)
   core::KSPH krylov_;   ///< GMRES on J_, right-preconditioned by the factor in use (PC shell)
+  LinearSolver linear_ = LinearSolver::direct;  ///< resolved (never automatic)
+  core::KSPH amg_;      ///< multigrid kind: CG + AMG on J_
+  bool amg_current_ = false;  ///< amg_'s preconditioner is of the assembled tangent
   bool use_rest_ = false;
   bool current_ = false;
   double forcing_ = 1e-3;
