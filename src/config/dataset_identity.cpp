@@ -34,6 +34,14 @@ std::string shapes_text(const DatasetConfig& c) {
 }
 
 std::string solver_text(const solver::SolverOptions& s) {
+  // The linear solver joins the identity only when it is not the default (so that datasets
+  // made before the key existed keep theirs): AMG and a factorisation agree to the tolerance,
+  // not bit for bit.
+  const solver::TangentOptions defaults;
+  std::string linear;
+  if (s.tangent.linear != defaults.linear || s.tangent.auto_dofs != defaults.auto_dofs)
+    linear = fmt::format("  linear: {}\n  linear_auto_dofs: {}\n", solver::to_string(s.tangent.linear),
+                         s.tangent.auto_dofs);
   return fmt::format(
       "solver:\n  rtol: {}\n  atol: {}\n  control: {}\n  path_rtol: {}\n  newton_budget: {}\n  fallback: {}\n"
       "  branch_switches: {}\n  max_halvings: {}\n  max_newton: {}\n  factor_reuse: {}\n  krylov_budget: {}\n"
@@ -41,7 +49,8 @@ std::string solver_text(const solver::SolverOptions& s) {
       "  max_target_solves: {}\n",
       num(s.rtol), num(s.atol), int(s.control), num(s.path_rtol), s.newton_budget, s.fallback, s.branch_switches,
       s.max_halvings, s.max_newton, s.tangent.reuse, s.tangent.krylov_budget, num(s.tangent.krylov_rtol),
-      s.max_increments, num(s.min_increment), s.guard, num(s.target_rtol), s.max_target_solves);
+      s.max_increments, num(s.min_increment), s.guard, num(s.target_rtol), s.max_target_solves) +
+         linear;
 }
 
 }  // namespace
