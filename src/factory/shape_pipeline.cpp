@@ -64,51 +64,81 @@ std::vector<double> base_sample(const ShapeConfig& c, const std::optional<geomet
   return geometry::icosphere(4).points;
 }
 
-/// The boundary of one attempt, conforming to the Dirichlet patch; throws Rejection.
-geometry::Boundary draw_boundary(const ShapeConfig& c, const std::optional<geometry::Boundary>& base,
-                                 std::uint64_t seed, std::int64_t shape_id, int attempt,
-                                 ShapeSample& out) {
-  core::RandomStream rng(seed, core::Purpose::shape, {std::uint64_t(shape_id), std::uint64_t(attempt)});
-  core::RandomStream patch_rng(seed, core::Purpose::dirichlet, {std::uint64_t(shape_id), std::uint64_t(attempt)});
-  geometry::DeformationSpec spec = c.deformation;
-  spec.dim = c.dim;
-  geometry::RandomDeformation phi = geometry::sample_deformation(spec, base_sample(c, base), rng);
+/// 2D: the image of the circle resolved at h (curvature- and neck-limited sizes, graded),
+/// conforming to the patch ends; throws Rejection.
+geometry::Boundary draw_curve(const ShapeConfig& c, geometry::RandomDeformation& phi, core::RandomStream& patch_rng,
+                              ShapeSample& out) {
   const double h = c.h;
   const double min_feature = c.min_feature_fraction * h;
-  if (c.dim == 2) {
-    const double max_turn = c.max_turn_deg * std::numbers::pi / 180.0;
-    // Dense exact samples: a quarter of h and a fifth of the turning allowance per chord.
-    const geometry::CurveSamples dense = geometry::sample_circle_image(phi, h / 4, max_turn / 5);
-    const geometry::Boundary dense_polygon = geometry::polygon_boundary(dense.xy);
-    if (const auto check = geometry::check_boundary(dense_polygon); !check.ok)
-      throw Rejection{"boundary", check.reason};
-    // Local size: h, limited by curvature (turning <= max_turn per edge) and by the interior
-    // medial radius (at least two elements across every neck).
-    const std::vector<double> radius_in = geometry::inscribed_radii(dense_polygon);
-    const std::vector<double> radius_curv = geometry::curvature_radii(dense, h / 16);
-    std::vector<double> size(dense.size());
-    // A neck is where the inscribed ball is held by the opposite side (its radius is well below
-    // the local radius of curvature); a tight bend (tip) is resolved down to min_feature but
-    // not rejected: the mesh quality gate decides whether it can be meshed.
-    double thinnest = std::numeric_limits<double>::infinity();
-    for (std::size_t i = 0; i < size.size(); ++i) {
-      if (radius_in[i] < 0.5 * radius_curv[i]) thinnest = std::min(thinnest, radius_in[i]);
-      size[i] = std::max(min_feature, std::min({h, radius_curv[i] * max_turn, radius_in[i]}));
-    }
-    if (thinnest < min_feature)
-      throw Rejection{"feature", fmt::format("a neck of half-width {:.3g} is thinner than {:.3g} "
-                                             "(min_feature_fraction * h)", thinnest, min_feature)};
-    geometry::grade_sizes(dense, size, c.size_grading);
-    std::vector<double> forced;
-    if (c.dirichlet_radius > 0) {
-      out.dirichlet_center = geometry::uniform_boundary_point(dense_polygon, patch_rng);
-      // p_D sits on a chord of the dense samples; the exact crossings are on the curve.
-      forced = geometry::circle_crossings(phi, dense, {out.dirichlet_center.data(), 2}, c.dirichlet_radius);
-    }
-    geometry::Boundary b = geometry::resolve_curve(phi, dense, size, forced);
-    if (const auto check = geometry::check_boundary(b); !check.ok) throw Rejection{"boundary", check.reason};
-    return b;
+  const double max_turn = c.max_turn_deg * std::numbers::pi / 180.0;
+  // Dense exact samples: a quarter of h and a fifth of the turning allowance per chord.
+  const geometry::CurveSamples dense = geometry::sample_circle_image(phi, h / 4, max_turn / 5);
+  const geometry::Boundary dense_polygon = geometry::polygon_boundary(dense.xy);
+  if (const auto check = geometry::check_boundary(dense_polygon); !check.ok)
+    throw Rejection{"boundary", check.reason};
+  // Local size: h, limited by curvature (turning <= max_turn per edge) and by the interior
+  // medial radius (at least two elements across every neck).
+  const std::vector<double> radius_in = geometry::inscribed_radii(dense_polygon);
+  const std::vector<double> radius_curv = geometry::curvature_radii(dense, h / 16);
+  std::vector<double> size(dense.size());
+  // A neck is where the inscribed ball is held by the opposite side (its radius is well below
+  // the local radius of curvature); a tight bend (tip) is resolved down to min_feature but
+  // not rejected: the mesh quality gate decides whether it can be meshed.
+  double thinnest = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < size.size(); ++i) {
+    if (radius_in[i] < 0.5 * radius_curv[i]) thinnest = std::min(thinnest, radius_in[i]);
+    size[i] = std::max(min_feature, std::min({h, radius_curv[i] * max_turn, radius_in[i]}));
   }
+  if (thinnest < min_feature)
+    throw Rejection{"feature", fmt::format("a neck of half-width {:.3g} is thinner than {:.3g} "
+                                           "(min_feature_fraction * h)", thinnest, min_feature)};
+  geometry::grade_sizes(dense, size, c.size_grading);
+  std::vector<double> forced;
+  if (c.dirichlet_radius > 0) {
+    out.dirichlet_center = geometry::uniform_boundary_point(dense_polygon, patch_rng);
+    // p_D sits on a chord of the dense samples; the exact crossings are on the curve.
+    forced = geometry::circle_crossings(phi, dense, {out.dirichlet_center.data(), 2}, c.dirichlet_radius);
+  }
+  geometry::Boundary b = geometry::resolve_curve(phi, dense, size, forced);
+  if (const auto check = geometry::check_boundary(b); !check.ok) throw Rejection{"boundary", check.reason};
+  return b;
+}
+
+/// 3D: the surface's accepted necks are at least this wide (surfaces are remeshed uniformly at
+/// h: a neck must hold two boundary edges across).
+double min_neck(const ShapeConfig& c) { return std::max(c.min_feature_fraction * c.h, 0.25 * c.h); }
+
+/// 3D: the simulation surface from the drawn one when they differ (coarser, or refined at the
+/// rim), held to the same checks; throws Rejection.
+geometry::Boundary simulation_surface(geometry::Boundary b, const ShapeConfig& c, const ShapeSample& out) {
+  const double h = c.h, neck = min_neck(c);
+  const double surface_h = c.surface_h > 0 ? c.surface_h : c.mesh_h;
+  if (surface_h <= h && c.rim_size <= 0) return b;
+  // A simulation surface other than the drawn one (coarser, or refined at the rim): the accepted
+  // surface remeshed (same clamp sphere), which must pass the same checks; its necks are held to
+  // the h-level threshold, so a neck the coarse surface pinches is redrawn rather than solved on.
+  const std::string what = fmt::format("remeshed at {:g}{}", std::max(surface_h, h),
+                                       c.rim_size > 0 ? fmt::format(" (rim {:g})", c.rim_size) : "");
+  try {
+    b = solve_surface(b, c, out.dirichlet_center);
+  } catch (const std::exception& e) {
+    throw Rejection{"boundary", fmt::format("{}: {}", what, e.what())};
+  }
+  if (const auto check = geometry::check_boundary(b); !check.ok)
+    throw Rejection{"boundary", fmt::format("{}: {}", what, check.reason)};
+  const std::vector<double> coarse_in = geometry::inscribed_radii(b);
+  if (const double t = *std::min_element(coarse_in.begin(), coarse_in.end()); t < neck)
+    throw Rejection{"feature", fmt::format("{}, a neck of half-width {:.3g} "
+                                           "is thinner than {:.3g}", what, t, neck)};
+  return b;
+}
+
+
+/// 3D: the image of the base surface resolved at h in the pre-image, remeshed to h conforming
+/// to the patch curve; throws Rejection.
+geometry::Boundary draw_surface(const ShapeConfig& c, const std::optional<geometry::Boundary>& base,
+                                geometry::RandomDeformation& phi, core::RandomStream& patch_rng, ShapeSample& out) {
+  const double h = c.h;
   // 3D: resolve the surface at h in the pre-image, then remesh it to h (conforming to the
   // patch curve), and to mesh_h where the mesh is coarser.
   const geometry::BaseKind kind = base ? geometry::BaseKind::triangulated : geometry::BaseKind::sphere;
@@ -144,30 +174,24 @@ geometry::Boundary draw_boundary(const ShapeConfig& c, const std::optional<geome
   const double thinnest = *std::min_element(radius_in.begin(), radius_in.end());
   // Surfaces are remeshed uniformly at h (CGAL 5.5 has no adaptive sizing), so a neck must
   // hold at least two boundary edges across.
-  const double neck = std::max(min_feature, 0.25 * h);
+  const double neck = min_neck(c);
   if (thinnest < neck)
     throw Rejection{"feature", fmt::format("a neck of half-width {:.3g} is thinner than {:.3g} "
                                            "(h / 4: surfaces are resolved uniformly at h)",
                                            thinnest, neck)};
-  const double surface_h = c.surface_h > 0 ? c.surface_h : c.mesh_h;
-  if (surface_h <= h && c.rim_size <= 0) return b;
-  // A simulation surface other than the drawn one (coarser, or refined at the rim): the accepted
-  // surface remeshed (same clamp sphere), which must pass the same checks; its necks are held to
-  // the h-level threshold, so a neck the coarse surface pinches is redrawn rather than solved on.
-  const std::string what = fmt::format("remeshed at {:g}{}", std::max(surface_h, h),
-                                       c.rim_size > 0 ? fmt::format(" (rim {:g})", c.rim_size) : "");
-  try {
-    b = solve_surface(b, c, out.dirichlet_center);
-  } catch (const std::exception& e) {
-    throw Rejection{"boundary", fmt::format("{}: {}", what, e.what())};
-  }
-  if (const auto check = geometry::check_boundary(b); !check.ok)
-    throw Rejection{"boundary", fmt::format("{}: {}", what, check.reason)};
-  const std::vector<double> coarse_in = geometry::inscribed_radii(b);
-  if (const double t = *std::min_element(coarse_in.begin(), coarse_in.end()); t < neck)
-    throw Rejection{"feature", fmt::format("{}, a neck of half-width {:.3g} "
-                                           "is thinner than {:.3g}", what, t, neck)};
-  return b;
+  return simulation_surface(std::move(b), c, out);
+}
+
+/// The boundary of one attempt, conforming to the Dirichlet patch; throws Rejection.
+geometry::Boundary draw_boundary(const ShapeConfig& c, const std::optional<geometry::Boundary>& base,
+                                 std::uint64_t seed, std::int64_t shape_id, int attempt,
+                                 ShapeSample& out) {
+  core::RandomStream rng(seed, core::Purpose::shape, {std::uint64_t(shape_id), std::uint64_t(attempt)});
+  core::RandomStream patch_rng(seed, core::Purpose::dirichlet, {std::uint64_t(shape_id), std::uint64_t(attempt)});
+  geometry::DeformationSpec spec = c.deformation;
+  spec.dim = c.dim;
+  geometry::RandomDeformation phi = geometry::sample_deformation(spec, base_sample(c, base), rng);
+  return c.dim == 2 ? draw_curve(c, phi, patch_rng, out) : draw_surface(c, base, phi, patch_rng, out);
 }
 
 /// A surface file normalised into [-1, 1]^3. Throws core::InputError.
