@@ -306,7 +306,130 @@ void drop_shorthands(YAML::Node& preset, const YAML::Node& own, const std::strin
   if (preset["shapes"]) preset["shapes"].remove("dirichlet_radius");
 }
 
+/// A config naming a preset: the preset's YAML merged under the config's (which wins); relative
+/// paths stay relative to the preset's directory unless the config gives its own.
+YAML::Node merge_preset(YAML::Node root, const std::string& source, DatasetConfig& c, std::string& base_dir) {
+  YamlBlock top(root, source, "");
+  c.preset = top.text("preset");
+  const Preset* found = nullptr;
+  std::string names;
+  for (const auto& p : presets()) {
+    names += (names.empty() ? "" : ", ") + std::string(p.name);
+    if (c.preset == p.name) found = &p;
+  }
+  if (!found) top.fail("preset", "unknown preset '" + c.preset + "'; presets: " + names);
+  YAML::Node base = YAML::Load(found->text);
+  root.remove("preset");
+  if (root["effects"]) drop_shorthands(base, root, source);
+  // A preset's relative paths (base_file, base_dir) stay relative to the preset's directory
+  // unless the config gives its own.
+  if (!(root["shapes"] && (root["shapes"]["base_file"] || root["shapes"]["base_dir"])))
+    base_dir = found->directory;
+  root = merge(base, root);
+  return root;
+}
+
+/// mesh: degree, and in 3D the mesh, surface and rim edge lengths.
+void parse_mesh(const YamlBlock& top, const std::string& source, DatasetConfig& c) {
+  YamlBlock m(top.get("mesh"), source, "mesh");
+  if (m.has("degree")) {
+    const long d = m.integer("degree");
+    if (d != 1 && d != 2) m.fail("degree", "must be 1 or 2");
+    c.degree = int(d);
+  }
+  if (m.has("h")) {
+    const double mh = m.number("h");
+    if (c.shapes.dim != 3)
+      m.fail("h", "only for 3D shapes (a 2D boundary is resolved by curvature and shapes.h; "
+                  "set shapes.h)");
+    if (!(mh >= c.shapes.h && mh <= 0.5))
+      m.fail("h", fmt::format("must be in [shapes.h = {:g}, 0.5] (the mesh is never finer than "
+                              "the surface the shape is drawn at; the 3D presets set mesh.h "
+                              "(0.2 or 0.3): with a coarser shapes.h set mesh.h too)", c.shapes.h));
+    c.shapes.mesh_h = mh;
+  }
+  if (m.has("surface_h")) {
+    const double sh = m.number("surface_h");
+    if (c.shapes.dim != 3) m.fail("surface_h", "only for 3D shapes");
+    const double mh = std::max(c.shapes.h, c.shapes.mesh_h);
+    if (!(sh >= c.shapes.h && sh <= mh))
+      m.fail("surface_h", fmt::format("must be in [shapes.h = {:g}, mesh.h = {:g}] (shapes.h: the surface "
+                                      "as drawn, with a coarser interior)", c.shapes.h, mh));
+    c.shapes.surface_h = sh;
+  }
+  if (m.has("rim")) {
+    const double rim = m.number("rim");
+    if (c.shapes.dim != 3) m.fail("rim", "only for 3D shapes (2D boundaries are graded at the patch ends)");
+    if (!(rim > 0 && rim <= std::max(c.shapes.h, c.shapes.mesh_h)))
+      m.fail("rim", "must be in (0, mesh.h] (edge length at the clamp rim)");
+    c.shapes.rim_size = rim;
+  }
+  m.allowed("degree, h (3D: mesh edge length when coarser than shapes.h), surface_h (3D: surface edge "
+            "length, shapes.h keeps it as drawn), rim (3D: edge length at the clamp rim)");
+  m.check_all_used();
+}
+
+void parse_representations(const YamlBlock& top, const std::string& source, DatasetConfig& c) {
+  YamlBlock r(top.get("representations"), source, "representations");
+  auto& rep = c.representations;
+  rep.point_cloud = flag(r, "point_cloud", true);
+  rep.grid = flag(r, "grid", true);
+  rep.grid_size = c.shapes.dim == 2 ? 128 : 64;
+  if (r.has("grid_size")) {
+    const long n = r.integer("grid_size");
+    if (n < 2 || n > (c.shapes.dim == 2 ? 4096 : 512))
+      r.fail("grid_size", c.shapes.dim == 2 ? "must be in [2, 4096]" : "must be in [2, 512]");
+    rep.grid_size = int(n);
+  }
+  r.allowed("point_cloud, grid, grid_size");
+  r.check_all_used();
+}
+
+void parse_split(const YamlBlock& top, const std::string& source, DatasetConfig& c) {
+  YamlBlock s(top.get("split"), source, "split");
+  auto& sp = c.split;
+  if (s.has("train")) sp.train = s.number("train");
+  if (s.has("val")) sp.val = s.number("val");
+  if (s.has("test")) sp.test = s.number("test");
+  if (sp.train < 0 || sp.val < 0 || sp.test < 0 || std::abs(sp.train + sp.val + sp.test - 1.0) > 1e-9)
+    s.fail("", "train, val and test must be >= 0 and sum to 1");
+  s.allowed("train, val, test");
+  s.check_all_used();
+}
+
+void parse_output(const YamlBlock& top, const std::string& source, DatasetConfig& c) {
+  YamlBlock o(top.get("output"), source, "output");
+  if (o.has("shard_size")) {
+    const long n = o.integer("shard_size");
+    if (n < 1 || n > 100000) o.fail("shard_size", "must be in [1, 100000] (shapes per shard)");
+    c.shard_size = int(n);
+  }
+  o.allowed("shard_size");
+  o.check_all_used();
+}
+
+/// The resolved config, stored with the data: the preset merged in, paths made absolute, the
+/// count of a directory family written out, and its files listed (in comments: the text is
+/// the dataset's identity, so a rerun on other files is another dataset).
+std::string resolved_text(YAML::Node root, const DatasetConfig& c) {
+  if (!c.shapes.base_file.empty()) root["shapes"]["base_file"] = c.shapes.base_file;
+  std::string files;
+  if (c.shapes.base == "directory") {
+    root["shapes"]["base_dir"] = c.shapes.base_dir;
+    root["shapes"]["count"] = c.n_shapes;
+    files = "# shapes.base_dir: shape i is file i of\n";
+    for (std::size_t i = 0; i < c.shapes.base_files.size(); ++i)
+      files += "#   " + std::to_string(i) + ": " +
+               std::filesystem::path(c.shapes.base_files[i]).filename().string() + "\n";
+  }
+  YAML::Emitter e;
+  e << root;
+  return std::string("# hypershape dataset config, resolved") +
+           (c.preset.empty() ? "" : " from preset " + c.preset) + "\n" + e.c_str() + "\n" + files;
+}
+
 }  // namespace
+
 
 const char* default_dataset_text() {
   return R"(# The embedded default dataset: a small slice of Random2D (seed paper, Table 1).
@@ -327,25 +450,7 @@ DatasetConfig parse_dataset_text(const std::string& text, const std::string& sou
   DatasetConfig c;
   c.source = source;
   std::string base_dir = base_dir_in;
-  if (root["preset"]) {
-    YamlBlock top(root, source, "");
-    c.preset = top.text("preset");
-    const Preset* found = nullptr;
-    std::string names;
-    for (const auto& p : presets()) {
-      names += (names.empty() ? "" : ", ") + std::string(p.name);
-      if (c.preset == p.name) found = &p;
-    }
-    if (!found) top.fail("preset", "unknown preset '" + c.preset + "'; presets: " + names);
-    YAML::Node base = YAML::Load(found->text);
-    root.remove("preset");
-    if (root["effects"]) drop_shorthands(base, root, source);
-    // A preset's relative paths (base_file, base_dir) stay relative to the preset's directory
-    // unless the config gives its own.
-    if (!(root["shapes"] && (root["shapes"]["base_file"] || root["shapes"]["base_dir"])))
-      base_dir = found->directory;
-    root = merge(base, root);
-  }
+  if (root["preset"]) root = merge_preset(root, source, c, base_dir);
   YamlBlock top(root, source, "");
   c.name = top.text("name");
   check_name(top, c.name);
@@ -368,101 +473,15 @@ DatasetConfig parse_dataset_text(const std::string& text, const std::string& sou
   } else {
     c.scene = shorthand_scene(c, source);
   }
-  {
-    YamlBlock m(top.get("mesh"), source, "mesh");
-    if (m.has("degree")) {
-      const long d = m.integer("degree");
-      if (d != 1 && d != 2) m.fail("degree", "must be 1 or 2");
-      c.degree = int(d);
-    }
-    if (m.has("h")) {
-      const double mh = m.number("h");
-      if (c.shapes.dim != 3)
-        m.fail("h", "only for 3D shapes (a 2D boundary is resolved by curvature and shapes.h; "
-                    "set shapes.h)");
-      if (!(mh >= c.shapes.h && mh <= 0.5))
-        m.fail("h", fmt::format("must be in [shapes.h = {:g}, 0.5] (the mesh is never finer than "
-                                "the surface the shape is drawn at; the 3D presets set mesh.h "
-                                "(0.2 or 0.3): with a coarser shapes.h set mesh.h too)", c.shapes.h));
-      c.shapes.mesh_h = mh;
-    }
-    if (m.has("surface_h")) {
-      const double sh = m.number("surface_h");
-      if (c.shapes.dim != 3) m.fail("surface_h", "only for 3D shapes");
-      const double mh = std::max(c.shapes.h, c.shapes.mesh_h);
-      if (!(sh >= c.shapes.h && sh <= mh))
-        m.fail("surface_h", fmt::format("must be in [shapes.h = {:g}, mesh.h = {:g}] (shapes.h: the surface "
-                                        "as drawn, with a coarser interior)", c.shapes.h, mh));
-      c.shapes.surface_h = sh;
-    }
-    if (m.has("rim")) {
-      const double rim = m.number("rim");
-      if (c.shapes.dim != 3) m.fail("rim", "only for 3D shapes (2D boundaries are graded at the patch ends)");
-      if (!(rim > 0 && rim <= std::max(c.shapes.h, c.shapes.mesh_h)))
-        m.fail("rim", "must be in (0, mesh.h] (edge length at the clamp rim)");
-      c.shapes.rim_size = rim;
-    }
-    m.allowed("degree, h (3D: mesh edge length when coarser than shapes.h), surface_h (3D: surface edge "
-              "length, shapes.h keeps it as drawn), rim (3D: edge length at the clamp rim)");
-    m.check_all_used();
-  }
-  {
-    YamlBlock r(top.get("representations"), source, "representations");
-    auto& rep = c.representations;
-    rep.point_cloud = flag(r, "point_cloud", true);
-    rep.grid = flag(r, "grid", true);
-    rep.grid_size = c.shapes.dim == 2 ? 128 : 64;
-    if (r.has("grid_size")) {
-      const long n = r.integer("grid_size");
-      if (n < 2 || n > (c.shapes.dim == 2 ? 4096 : 512))
-        r.fail("grid_size", c.shapes.dim == 2 ? "must be in [2, 4096]" : "must be in [2, 512]");
-      rep.grid_size = int(n);
-    }
-    r.allowed("point_cloud, grid, grid_size");
-    r.check_all_used();
-  }
-  {
-    YamlBlock s(top.get("split"), source, "split");
-    auto& sp = c.split;
-    if (s.has("train")) sp.train = s.number("train");
-    if (s.has("val")) sp.val = s.number("val");
-    if (s.has("test")) sp.test = s.number("test");
-    if (sp.train < 0 || sp.val < 0 || sp.test < 0 || std::abs(sp.train + sp.val + sp.test - 1.0) > 1e-9)
-      s.fail("", "train, val and test must be >= 0 and sum to 1");
-    s.allowed("train, val, test");
-    s.check_all_used();
-  }
-  {
-    YamlBlock o(top.get("output"), source, "output");
-    if (o.has("shard_size")) {
-      const long n = o.integer("shard_size");
-      if (n < 1 || n > 100000) o.fail("shard_size", "must be in [1, 100000] (shapes per shard)");
-      c.shard_size = int(n);
-    }
-    o.allowed("shard_size");
-    o.check_all_used();
-  }
+  parse_mesh(top, source, c);
+  parse_representations(top, source, c);
+  parse_split(top, source, c);
+  parse_output(top, source, c);
   parse_solver_block(YamlBlock(top.get("solver"), source, "solver"), c.solver);
   parse_petsc_block(YamlBlock(top.get("petsc"), source, "petsc"), c.petsc);
   top.allowed("preset, name, seed, shapes, loads, material, effects, mesh, representations, split, output, solver, petsc");
   top.check_all_used();
-  // The resolved config, stored with the data: the preset merged in, paths made absolute, the
-  // count of a directory family written out, and its files listed (in comments: the text is
-  // the dataset's identity, so a rerun on other files is another dataset).
-  if (!c.shapes.base_file.empty()) root["shapes"]["base_file"] = c.shapes.base_file;
-  std::string files;
-  if (c.shapes.base == "directory") {
-    root["shapes"]["base_dir"] = c.shapes.base_dir;
-    root["shapes"]["count"] = c.n_shapes;
-    files = "# shapes.base_dir: shape i is file i of\n";
-    for (std::size_t i = 0; i < c.shapes.base_files.size(); ++i)
-      files += "#   " + std::to_string(i) + ": " +
-               std::filesystem::path(c.shapes.base_files[i]).filename().string() + "\n";
-  }
-  YAML::Emitter e;
-  e << root;
-  c.text = std::string("# hypershape dataset config, resolved") +
-           (c.preset.empty() ? "" : " from preset " + c.preset) + "\n" + e.c_str() + "\n" + files;
+  c.text = resolved_text(root, c);
   return c;
 }
 
