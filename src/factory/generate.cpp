@@ -290,6 +290,22 @@ void add_to_report(const ShapeJobResult& r, RunReport& rep) {
   rep.failed_increments += r.failed_increments;
   rep.recovery_iterations += r.recovery_iterations;
   rep.linear += r.linear;
+  const auto find = [&](const std::string& name) -> const io::Array* {
+    for (const auto& a : r.entry.arrays)
+      if (a.name == name) return &a;
+    return nullptr;
+  };
+  const io::Array* est = find("loads/error_estimate_rel_l2");
+  const io::Array* status = find("loads/status");
+  if (!est || !status) return;
+  const auto& v = std::get<std::vector<double>>(est->data);
+  const auto& st = std::get<std::vector<std::int8_t>>(status->data);
+  auto& s = rep.label_error;
+  for (std::size_t k = 0; k < v.size() && k < st.size(); ++k) {
+    if (!st[k]) continue;
+    s.n += 1, s.sum += v[k], s.max = std::max(s.max, v[k]);
+    s.above_1_percent += v[k] > 0.01, s.above_5_percent += v[k] > 0.05;
+  }
 }
 
 /// The run report's numbers over `comm`: counters summed over the group roots (each holds its
@@ -321,8 +337,16 @@ void reduce_report(MPI_Comm comm, bool group_root, const core::PhaseTimes& times
                           &rep.linear.krylov_iterations, &rep.linear.tangent_assemblies})
     *c = sum_roots(*c);
   rep.shards_written = sum_roots(shards_written);
+  for (std::int64_t* c : {&rep.label_error.n, &rep.label_error.above_1_percent, &rep.label_error.above_5_percent})
+    *c = sum_roots(*c);
+  {
+    double x[2] = {group_root ? rep.label_error.sum : 0.0, group_root ? rep.label_error.max : 0.0}, t[2];
+    MPI_Allreduce(&x[0], &t[0], 1, MPI_DOUBLE, MPI_SUM, comm);
+    MPI_Allreduce(&x[1], &t[1], 1, MPI_DOUBLE, MPI_MAX, comm);
+    rep.label_error.sum = t[0], rep.label_error.max = t[1];
+  }
   const std::vector<std::string> phases = {"shape", "mesh", "setup", "solve", "alpha_search",
-                                           "representations", "gather", "io"};
+                                           "error_estimate", "representations", "gather", "io"};
   for (const auto& p : phases) {
     double x = group_root ? times.get(p) : 0, total = 0;
     MPI_Allreduce(&x, &total, 1, MPI_DOUBLE, MPI_SUM, comm);
@@ -364,6 +388,14 @@ bool report_and_index(const config::DatasetConfig& cfg, const GenerateOptions& o
                  {"symbolic_factorizations", rep.linear.symbolic_factorizations},
                  {"krylov_iterations", rep.linear.krylov_iterations},
                  {"tangent_assemblies", rep.linear.tangent_assemblies}};
+  {
+    const auto& e = rep.label_error;
+    j["label_error_estimate"] = {{"load_cases", e.n},
+                                 {"mean_rel_l2", e.n ? e.sum / double(e.n) : 0.0},
+                                 {"max_rel_l2", e.max},
+                                 {"above_1_percent", e.above_1_percent},
+                                 {"above_5_percent", e.above_5_percent}};
+  }
   j["seconds"] = {{"wall", rep.seconds}, {"phases_summed_over_groups", rep.phase_seconds},
                   {"factorization_PCSetUp_summed_over_ranks", rep.factorization_seconds}};
   j["peak_rss_mib_per_rank"] = rss;
@@ -517,6 +549,9 @@ std::string report_table(const RunReport& r) {
   for (const auto& [k, v] : r.phase_seconds)
     s += fmt::format("  {:<17s} {:8.2f}  {:5.1f}%\n", k, v, 100 * v / std::max(1e-9, total));
   s += fmt::format("  (factorisations, PCSetUp: {:.2f} s of solve + alpha_search)\n", r.factorization_seconds);
+  if (const auto& e = r.label_error; e.n > 0)
+    s += fmt::format("  label error estimate (relative L2 of u): mean {:.3g}, max {:.3g}; above 1%: {} of {}, "
+                     "above 5%: {}\n", e.sum / double(e.n), e.max, e.above_1_percent, e.n, e.above_5_percent);
   return s;
 }
 

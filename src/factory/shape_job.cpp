@@ -10,6 +10,7 @@
 
 #include "hypershape/core/error.hpp"
 #include "hypershape/factory/dataset_schema.hpp"
+#include "hypershape/factory/label_error.hpp"
 #include "hypershape/factory/load_cases.hpp"
 #include "hypershape/factory/shape_pipeline.hpp"
 #include "hypershape/factory/shape_set.hpp"
@@ -340,6 +341,7 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
   std::vector<float> grid_u;
   Channels channels(*problem, cfg.representations);
   DrawnParams drawn(cfg, shape_id, n_loads);
+  LabelErrors label_errors(n_loads);
   if (root) {
     displacement.assign(std::size_t(n_loads * n_nodes * d), 0.0);
     if (cfg.representations.grid) grid_u.assign(std::size_t(n_loads) * n_grid * std::size_t(d), 0.0f);
@@ -399,6 +401,10 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
       max_u[L] = min_det[L] = alpha[L] = 0;  // the fields stay zero: never NaN
       continue;
     }
+    {
+      auto t = out.times.scope("error_estimate");
+      label_errors.estimate(group, cfg, shape, cases[0], lc, *problem, nl->solution(), r.alpha);
+    }
     if (!root) continue;
     auto t = out.times.scope("representations");
     const std::size_t off = L * std::size_t(n_nodes * d);
@@ -441,6 +447,7 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
       s.push_back(du);
       arrays.push_back(schema_array("loads/grid_displacement", s, std::move(grid_u)));
     }
+    label_errors.store(arrays);
     channels.store(arrays, nl_, U64(n_nodes), grid_shape);
     drawn.store(arrays);
     moments.store(arrays);
