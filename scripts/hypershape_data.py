@@ -152,7 +152,8 @@ class Sample:
       solves, failed_increments, recovery_iterations (int)
       error_estimate_rel_l2, error_estimate_max_u, error_estimate_alpha (float): the label's own
                    estimated error (relative L2 of u; relative, signed, of max|u| and of alpha;
-                   NaN when the dataset has no estimates, 0 for a failed load case)
+                   NaN when the dataset has no estimates, 0 for a failed load case, -1 when
+                   no estimate could be formed)
       params       dict: drawn scene parameter "<effect label>/<key>" -> its value for this
                    load case (float, or (d,) for a further traction's centre/direction)
     The input channels the scene's effects bring (Dataset.channels: "traction", "body_force",
@@ -704,17 +705,23 @@ def error_estimates(ds, worst=5):
     if not rows:
         return None
     a = np.array([r[2:] for r in rows])
+    missing = int((a[:, 0] < 0).sum())  # -1: no estimate could be formed
+    rows = [r for r, k in zip(rows, a[:, 0] >= 0) if k]
+    a = a[a[:, 0] >= 0]
+    if not rows:
+        return {"load_cases": 0, "without_estimate": missing, "distribution_of_magnitude": {}, "worst_by_rel_l2": []}
     q = (50, 90, 99, 100)
     dist = {k: {f"p{p}": float(np.percentile(np.abs(a[:, i]), p)) for p in q} for i, k in enumerate(ERROR_ESTIMATES)}
     order = np.argsort(-a[:, 0])[:worst]
-    return {"load_cases": len(rows), "distribution_of_magnitude": dist,
+    return {"load_cases": len(rows), "without_estimate": missing, "distribution_of_magnitude": dist,
             "worst_by_rel_l2": [{"shape": rows[i][0], "load": rows[i][1], "rel_l2": rows[i][2],
                                  "max_u": rows[i][3], "alpha": rows[i][4]} for i in order]}
 
 
 def print_error_estimates(e, out=sys.stdout):
     w = lambda s: print(s, file=out)  # noqa: E731
-    w(f"  label error estimates over {e['load_cases']} converged load cases (|value| quantiles):")
+    w(f"  label error estimates over {e['load_cases']} converged load cases (|value| quantiles; "
+      f"{e['without_estimate']} without an estimate):")
     for k, d in e["distribution_of_magnitude"].items():
         w(f"    {k:<24}" + "  ".join(f"{p} {v:.3g}" for p, v in d.items()))
     w("    worst load cases by rel_l2: " + ", ".join(

@@ -40,7 +40,8 @@ points per axis, n: mesh nodes of the shape, m: cells, k: nodes per cell):
     with_mesh=True adds "cells" (m, k) int64 (for rel_h1).
 
 Both carry "error_estimate" (3,) float64: the label's own estimated error (relative L2 of u;
-relative, signed, error of max|u| and of alpha; NaN without estimates; docs/ACCURACY.md).
+relative, signed, error of max|u| and of alpha; NaN without estimates, -1 where none could be
+formed; docs/ACCURACY.md).
 max_error=E keeps only the load cases whose relative L2 estimate is <= E; the dataset's
 error_estimates attribute ((len, 3) numpy, item order) lets a user weight samples, e.g.
 torch.utils.data.WeightedRandomSampler(1 / (1 + ds.error_estimates[:, 0] / 0.01), len(ds)).
@@ -105,7 +106,7 @@ class _Base(torch.utils.data.Dataset):
         per_shape = {sid: hd.shape_error_estimates(self.reader, sid) for sid in sorted({k[0] for k in self.index})}
         est = np.array([per_shape[sid][lid] for sid, lid in self.index]).reshape(-1, 3)
         if max_error is not None:
-            keep = est[:, 0] <= max_error  # NaN (no estimate) is not <= anything: dropped
+            keep = (est[:, 0] >= 0) & (est[:, 0] <= max_error)  # -1 / NaN (no estimate): dropped
             self.index = [k for k, ok in zip(self.index, keep) if ok]
             est = est[keep]
         self.error_estimates = est

@@ -41,6 +41,7 @@ void LabelErrors::estimate(MPI_Comm group, const config::DatasetConfig& cfg, con
   const auto L = std::size_t(lc.load_id);
   try {
     if (!estimator_) estimator_ = std::make_unique<LabelErrorEstimator>(group, cfg, shape, first, coarse);
+    rel_l2_[L] = max_u_[L] = alpha_[L] = -1;  // no estimate (until it is formed)
     const solver::ErrorEstimate e = estimator_->estimate(cfg, lc, u, alpha);
     if (!e.ok) return;
     rel_l2_[L] = e.rel_l2;

@@ -160,6 +160,9 @@ void run_shape(const config::DatasetConfig& cfg, const factory::ShapeSample& sha
       j["estimate_krylov_iterations"] = e.krylov_iterations;
       j["est_raw_max_u"] = e.raw_max_u;
       j["est_slope"] = e.slope;
+      j["estimate_newton_converged"] = e.newton_steps_converged;
+      j["estimate_tangent_assemblies"] = e.tangent_assemblies;
+      j["estimate_residual_assemblies"] = e.residual_assemblies;
       std::vector<std::vector<double>> u;
       std::vector<double> alphas;
       std::string why;

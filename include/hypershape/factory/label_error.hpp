@@ -38,14 +38,16 @@ class LabelErrorEstimator {
 };
 
 /// The per-load-case estimates of one shape, as the shape job stores them
-/// (loads/error_estimate_rel_l2, _max_u, _alpha; 0 for a load case that failed or whose
-/// estimate could not be formed). The estimator is built at the first converged load case.
+/// (loads/error_estimate_rel_l2, _max_u, _alpha; 0 for a load case that failed, -1 in all
+/// three for a converged one whose estimate could not be formed: the fine Newton step found
+/// no descent, e.g. a state the refined mesh does not hold stable). The estimator is built at
+/// the first converged load case.
 /// Switched off by the PETSc option -error_estimate false.
 class LabelErrors {
  public:
   explicit LabelErrors(int n_loads);
-  /// Estimates load case `lc` (converged: u at alpha). Collective over `group`; a failure is
-  /// logged and leaves 0, never thrown.
+  /// Estimates load case `lc` (converged: u at alpha). Collective over `group`; a failure
+  /// leaves -1 (a PETSc error is logged), never thrown.
   void estimate(MPI_Comm group, const config::DatasetConfig& cfg, const ShapeSample& shape, const LoadCase& first,
                 const LoadCase& lc, const physics::Problem& coarse, Vec u, double alpha);
   /// Appends the three arrays (group root).

@@ -35,9 +35,10 @@ struct ErrorEstimate {
   double raw_max_u = 0;      ///< max_u with theta = 1
   double slope = 0;          ///< dmax|u| / dalpha used for the alpha estimate
   int krylov_iterations = 0;
+  bool newton_steps_converged = false;  ///< the fine Newton steps left <= 1% of the first residual
   int residual_assemblies = 0, tangent_assemblies = 0, factorizations = 0;
   double seconds = 0;
-  double seconds_assembly = 0, seconds_linear = 0;  ///< parts of `seconds`: tangents + residual; the solve
+  double seconds_assembly = 0, seconds_linear = 0;  ///< parts of `seconds`: fine residuals and tangents; the fine solves
 };
 
 /// The exact L2 norm squared of a P1/P2 nodal field (n_comp components, canonical node order)
@@ -68,6 +69,8 @@ class TwoLevelEstimator {
   Mat interpolation() const { return P_.get(); }
 
  private:
+  /// Newton on the fine problem from P u_h (the two-grid solver set up): e = u_fine - P u_h.
+  bool fine_newton(Vec Pu, double alpha, Vec e, ErrorEstimate& out) const;
   const physics::Problem& coarse_;
   const physics::Problem& fine_;
   /// Prolongation in canonical numbering (every rank): fine node i = sum_k w[k] coarse node
