@@ -303,6 +303,10 @@ void add_to_report(const ShapeJobResult& r, RunReport& rep) {
   auto& s = rep.label_error;
   for (std::size_t k = 0; k < v.size() && k < st.size(); ++k) {
     if (!st[k]) continue;
+    if (v[k] < 0) {  // -1: no estimate could be formed
+      s.missing += 1;
+      continue;
+    }
     s.n += 1, s.sum += v[k], s.max = std::max(s.max, v[k]);
     s.above_1_percent += v[k] > 0.01, s.above_5_percent += v[k] > 0.05;
   }
@@ -337,7 +341,8 @@ void reduce_report(MPI_Comm comm, bool group_root, const core::PhaseTimes& times
                           &rep.linear.krylov_iterations, &rep.linear.tangent_assemblies})
     *c = sum_roots(*c);
   rep.shards_written = sum_roots(shards_written);
-  for (std::int64_t* c : {&rep.label_error.n, &rep.label_error.above_1_percent, &rep.label_error.above_5_percent})
+  for (std::int64_t* c : {&rep.label_error.n, &rep.label_error.missing, &rep.label_error.above_1_percent,
+                          &rep.label_error.above_5_percent})
     *c = sum_roots(*c);
   {
     double x[2] = {group_root ? rep.label_error.sum : 0.0, group_root ? rep.label_error.max : 0.0}, t[2];
@@ -394,7 +399,8 @@ bool report_and_index(const config::DatasetConfig& cfg, const GenerateOptions& o
                                  {"mean_rel_l2", e.n ? e.sum / double(e.n) : 0.0},
                                  {"max_rel_l2", e.max},
                                  {"above_1_percent", e.above_1_percent},
-                                 {"above_5_percent", e.above_5_percent}};
+                                 {"above_5_percent", e.above_5_percent},
+                                 {"without_estimate", e.missing}};
   }
   j["seconds"] = {{"wall", rep.seconds}, {"phases_summed_over_groups", rep.phase_seconds},
                   {"factorization_PCSetUp_summed_over_ranks", rep.factorization_seconds}};
@@ -551,7 +557,8 @@ std::string report_table(const RunReport& r) {
   s += fmt::format("  (factorisations, PCSetUp: {:.2f} s of solve + alpha_search)\n", r.factorization_seconds);
   if (const auto& e = r.label_error; e.n > 0)
     s += fmt::format("  label error estimate (relative L2 of u): mean {:.3g}, max {:.3g}; above 1%: {} of {}, "
-                     "above 5%: {}\n", e.sum / double(e.n), e.max, e.above_1_percent, e.n, e.above_5_percent);
+                     "above 5%: {}; {} converged load cases without an estimate\n", e.sum / double(e.n), e.max,
+                     e.above_1_percent, e.n, e.above_5_percent, e.missing);
   return s;
 }
 

@@ -46,7 +46,7 @@ struct RunReport {
   double factorization_seconds = 0;             ///< PCSetUp, summed over ranks
   /// The labels' error estimates (loads/error_estimate_rel_l2) over the converged load cases.
   struct LabelErrorSummary {
-    std::int64_t n = 0, above_1_percent = 0, above_5_percent = 0;
+    std::int64_t n = 0, missing = 0, above_1_percent = 0, above_5_percent = 0;  ///< missing: -1 stored
     double sum = 0, max = 0;
   } label_error;
   std::string json;                              ///< the report as written (rank 0)

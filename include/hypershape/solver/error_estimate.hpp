@@ -35,7 +35,7 @@ struct ErrorEstimate {
   double raw_max_u = 0;      ///< max_u with theta = 1
   double slope = 0;          ///< dmax|u| / dalpha used for the alpha estimate
   int krylov_iterations = 0;
-  bool newton_steps_converged = false;  ///< the fine Newton steps left <= 1% of the first residual
+  bool newton_steps_converged = false;  ///< one full Newton step, or steps to 1% of the first residual
   int residual_assemblies = 0, tangent_assemblies = 0, factorizations = 0;
   double seconds = 0;
   double seconds_assembly = 0, seconds_linear = 0;  ///< parts of `seconds`: fine residuals and tangents; the fine solves
