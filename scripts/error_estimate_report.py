@@ -48,8 +48,10 @@ def line(name, rows):
     true = np.array([r["true_rel_l2"] for r in rows])
     share = np.array([r["estimate_seconds"] / max(r["solve_seconds"], 1e-12) for r in rows])
     its = np.array([r["estimate_krylov_iterations"] for r in rows])
+    fact = np.array([r["solve_factorizations"] for r in rows])
+    steps = np.array([r.get("estimate_tangent_assemblies", 2) - 1 for r in rows])
     cells += [f"{np.median(true):.2g}", f"{100 * np.median(share):.0f}% ({100 * np.max(share):.0f}%)",
-              f"{np.median(its):.0f}"]
+              f"{np.median(its):.0f}", f"{np.median(fact):.0f} / 1", f"{np.mean(steps):.2f}"]
     return "| " + " | ".join(cells) + " |"
 
 
@@ -66,8 +68,9 @@ def main():
     for r in rows:
         families.setdefault(r["case"], []).append(r)
     print("| cases | n | effectivity rel. L2: median [p10, p90] within [0.5, 2] | max\\|u\\| | alpha "
-          "| median true rel. L2 | estimate / solve time: median (max) | CG its |")
-    print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+          "| median true rel. L2 | estimate / solve time: median (max) | GMRES its | factorisations: solve / estimate "
+          "| fine Newton steps (mean) |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     for name in sorted(families):
         print(line(name, families[name]))
     for dim in (2, 3):
