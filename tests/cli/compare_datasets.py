@@ -5,7 +5,9 @@ from the arrays), splits.json and stats.json. Exit 0 if identical, 1 with the di
 
   compare_datasets.py A B             bit for bit
   compare_datasets.py A B --rtol R    floating-point values within R * max|value| of the array
-                                      (solver groups of several ranks sum in another order)"""
+                                      (solver groups of several ranks sum in another order;
+                                      the labels' error estimates, loads/error_estimate_*, an
+                                      iterative solve to rtol 1e-2, within max(R, 1e-2))"""
 import json
 import os
 import sys
@@ -23,9 +25,13 @@ def walk(group, prefix=""):
 
 
 RTOL = 0.0
+# The error estimates come from GMRES at rtol 1e-2 (src/solver/error_estimate.cpp): a partition
+# of the mesh over several ranks changes them at that level (measured: 5e-3 of the value).
+ESTIMATE_RTOL = 1e-2
 
 
-def same(x, y):
+def same(x, y, rtol=None):
+    rtol = RTOL if rtol is None else rtol
     x, y = np.asarray(x), np.asarray(y)
     if x.shape != y.shape or x.dtype != y.dtype:
         return False
@@ -35,8 +41,8 @@ def same(x, y):
         if not np.array_equal(nx, ny):
             return False
         x, y = x[~nx], y[~ny]
-    if RTOL > 0 and x.dtype.kind == "f" and x.size:
-        return bool(np.all(np.abs(x - y) <= RTOL * max(np.abs(x).max(), 1e-300)))
+    if rtol > 0 and x.dtype.kind == "f" and x.size:
+        return bool(np.all(np.abs(x - y) <= rtol * max(np.abs(x).max(), 1e-300)))
     return bool(np.array_equal(x, y))
 
 
@@ -63,7 +69,8 @@ def compare_h5(a, b, errors):
                 errors.append(f"{a}:{path}: attribute {k} differs")
         if isinstance(x, h5py.Dataset):
             n += 1
-            if not same(x[()], y[()]):
+            tol = max(RTOL, ESTIMATE_RTOL) if RTOL > 0 and "/error_estimate_" in path else None
+            if not same(x[()], y[()], tol):
                 errors.append(f"{a}:{path}: values differ")
     for k in set(fa.attrs) | set(fb.attrs):
         if not np.array_equal(fa.attrs.get(k), fb.attrs.get(k)):
