@@ -45,7 +45,7 @@ import numpy as np
 
 __all__ = [
     "open_dataset", "Dataset", "Shape", "Sample", "rel_l2", "rel_h1", "norm_l2", "norm_h1",
-    "nodal_gradient", "grid_axis", "grid_points", "grid_to_mesh", "check_dataset", "summary",
+    "nodal_gradient", "shape_error_estimates", "error_estimates", "grid_axis", "grid_points", "grid_to_mesh", "check_dataset", "summary",
 ]
 
 SPLITS = ("train", "val", "test")
@@ -150,6 +150,10 @@ class Sample:
       alpha, target, max_displacement, min_det_f, traction_normaliser (float)
       p_n (d,), g (d,) float64 (the first traction's; None without one); newton_iterations,
       solves, failed_increments, recovery_iterations (int)
+      error_estimate_rel_l2, error_estimate_max_u, error_estimate_alpha (float): the label's own
+                   estimated error (relative L2 of u; relative, signed, of max|u| and of alpha;
+                   NaN when the dataset has no estimates, 0 for a failed load case, -1 when
+                   no estimate could be formed)
       params       dict: drawn scene parameter "<effect label>/<key>" -> its value for this
                    load case (float, or (d,) for a further traction's centre/direction)
     The input channels the scene's effects bring (Dataset.channels: "traction", "body_force",
@@ -172,7 +176,10 @@ class Sample:
 
 # Per-load-case arrays under "loads/" with one row per load case.
 _LOAD_SCALARS = ("alpha", "target", "max_displacement", "min_det_f", "traction_normaliser",
-                 "newton_iterations", "solves", "failed_increments", "recovery_iterations")
+                 "newton_iterations", "solves", "failed_increments", "recovery_iterations",
+                 "error_estimate_rel_l2", "error_estimate_max_u", "error_estimate_alpha")
+# The a posteriori estimates of each label's own error (docs/ACCURACY.md), per load case.
+ERROR_ESTIMATES = ("error_estimate_rel_l2", "error_estimate_max_u", "error_estimate_alpha")
 _LOAD_COUNTS = ("newton_iterations", "solves", "failed_increments", "recovery_iterations")
 
 
@@ -658,6 +665,9 @@ def summary(path, out=sys.stdout):
         fmt = lambda a: "[" + ", ".join(f"{x:.4g}" for x in a) + "]"  # noqa: E731
         for k, f in sorted(ds.stats["fields"].items()):
             w(f"    {k:<24}{int(f['count'][0]):>10}  {fmt(f['mean']):<28}{fmt(f['std']):<28}{fmt(f['rms']):<28}")
+    est = error_estimates(ds)
+    if est is not None:
+        print_error_estimates(est, out)
     ok = ds.shape_ids()
     if ok:
         sid = ok[0]
@@ -669,6 +679,53 @@ def summary(path, out=sys.stdout):
             w(f"    {p:<31} {str(v.shape):<20}{str(v.dtype):<9}{units:<20}{meaning}")
     ds.close()
     return 0
+
+
+def shape_error_estimates(ds, shape_id):
+    """(L, 3) float64: error_estimate_rel_l2, _max_u, _alpha of every load case of a shape (NaN
+    when the dataset stores none)."""
+    gl = ds._group(shape_id)["loads"]
+    if ERROR_ESTIMATES[0] not in gl:
+        return np.full((ds.n_loads, 3), np.nan)
+    return np.stack([gl[k][...] for k in ERROR_ESTIMATES], axis=1).astype(np.float64)
+
+
+def error_estimates(ds, worst=5):
+    """The labels' own error estimates over a dataset's converged load cases: per estimate its
+    distribution (quantiles of the magnitude), and the `worst` load cases by the relative L2
+    estimate. None when the dataset stores no estimates."""
+    rows = []  # (shape, load, rel_l2, max_u, alpha)
+    for sid in ds.shape_ids():
+        gl = ds._group(sid)["loads"]
+        if ERROR_ESTIMATES[0] not in gl:
+            return None
+        st = gl["status"][...]
+        cols = [gl[k][...] for k in ERROR_ESTIMATES]
+        rows += [(sid, k, *(float(c[k]) for c in cols)) for k in range(len(st)) if st[k]]
+    if not rows:
+        return None
+    a = np.array([r[2:] for r in rows])
+    missing = int((a[:, 0] < 0).sum())  # -1: no estimate could be formed
+    rows = [r for r, k in zip(rows, a[:, 0] >= 0) if k]
+    a = a[a[:, 0] >= 0]
+    if not rows:
+        return {"load_cases": 0, "without_estimate": missing, "distribution_of_magnitude": {}, "worst_by_rel_l2": []}
+    q = (50, 90, 99, 100)
+    dist = {k: {f"p{p}": float(np.percentile(np.abs(a[:, i]), p)) for p in q} for i, k in enumerate(ERROR_ESTIMATES)}
+    order = np.argsort(-a[:, 0])[:worst]
+    return {"load_cases": len(rows), "without_estimate": missing, "distribution_of_magnitude": dist,
+            "worst_by_rel_l2": [{"shape": rows[i][0], "load": rows[i][1], "rel_l2": rows[i][2],
+                                 "max_u": rows[i][3], "alpha": rows[i][4]} for i in order]}
+
+
+def print_error_estimates(e, out=sys.stdout):
+    w = lambda s: print(s, file=out)  # noqa: E731
+    w(f"  label error estimates over {e['load_cases']} converged load cases (|value| quantiles; "
+      f"{e['without_estimate']} without an estimate):")
+    for k, d in e["distribution_of_magnitude"].items():
+        w(f"    {k:<24}" + "  ".join(f"{p} {v:.3g}" for p, v in d.items()))
+    w("    worst load cases by rel_l2: " + ", ".join(
+        f"shape {r['shape']} load {r['load']} ({r['rel_l2']:.3g})" for r in e["worst_by_rel_l2"]))
 
 
 def check_dataset(path, out=sys.stdout):

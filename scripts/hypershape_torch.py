@@ -39,6 +39,13 @@ points per axis, n: mesh nodes of the shape, m: cells, k: nodes per cell):
     "n_points", "shape_id", "load_id"  int64
     with_mesh=True adds "cells" (m, k) int64 (for rel_h1).
 
+Both carry "error_estimate" (3,) float64: the label's own estimated error (relative L2 of u;
+relative, signed, error of max|u| and of alpha; NaN without estimates, -1 where none could be
+formed; docs/ACCURACY.md).
+max_error=E keeps only the load cases whose relative L2 estimate is <= E; the dataset's
+error_estimates attribute ((len, 3) numpy, item order) lets a user weight samples, e.g.
+torch.utils.data.WeightedRandomSampler(1 / (1 + ds.error_estimates[:, 0] / 0.01), len(ds)).
+
 Grid items have one size and batch with the default collate. Point clouds differ in n:
 collate_padded pads them and adds "mask" (B, n_max) bool; "cells" stay a list.
 
@@ -89,13 +96,20 @@ def _field_norm(reader, field, mode, n_comp):
 class _Base(torch.utils.data.Dataset):
     _fields = None  # (sdf, dirichlet distance, channel prefix, displacement) names in stats.json
 
-    def __init__(self, path, split="train", normalize=None, dtype=torch.float32, with_mesh=False):
+    def __init__(self, path, split="train", normalize=None, dtype=torch.float32, with_mesh=False, max_error=None):
         if normalize not in NORMALIZATIONS:
             raise ValueError(f"normalize must be one of {NORMALIZATIONS}, got {normalize!r}")
         self.reader = hd.open_dataset(path)
         self.split, self.normalize, self.dtype, self.with_mesh = split, normalize, dtype, with_mesh
         self.dim = d = self.reader.dim
         self.index = self.reader.keys(split)  # (shape_id, load_id), converged only
+        per_shape = {sid: hd.shape_error_estimates(self.reader, sid) for sid in sorted({k[0] for k in self.index})}
+        est = np.array([per_shape[sid][lid] for sid, lid in self.index]).reshape(-1, 3)
+        if max_error is not None:
+            keep = (est[:, 0] >= 0) & (est[:, 0] <= max_error)  # -1 / NaN (no estimate): dropped
+            self.index = [k for k, ok in zip(self.index, keep) if ok]
+            est = est[keep]
+        self.error_estimates = est
         sdf, dd, prefix, u = self._fields
         # Inputs: sdf, dirichlet distance, then every channel the dataset's effects bring
         # (traction, body force, ...: Dataset.channels), d components each (pressure and a
@@ -126,8 +140,8 @@ class GridDataset(_Base):
 
     _fields = ("grid_sdf", "grid_dirichlet_distance", "grid_", "grid_displacement")
 
-    def __init__(self, path, split="train", normalize=None, dtype=torch.float32, with_mesh=False):
-        super().__init__(path, split, normalize, dtype, with_mesh)
+    def __init__(self, path, split="train", normalize=None, dtype=torch.float32, with_mesh=False, max_error=None):
+        super().__init__(path, split, normalize, dtype, with_mesh, max_error)
         if self.reader.grid_size is None:
             raise ValueError(f"{path}: no grid representation stored (representations.grid: false)")
         self.grid_size = self.reader.grid_size
@@ -145,7 +159,8 @@ class GridDataset(_Base):
         x = (torch.as_tensor(x, dtype=self.dtype) - self._xm) / self._xs
         y = (torch.as_tensor(cl(g["displacement"]), dtype=self.dtype) - self._ym) / self._ys
         item = {"x": x, "y": y, "inside": torch.as_tensor(g["inside"]),
-                "shape_id": torch.tensor(sid), "load_id": torch.tensor(lid)}
+                "shape_id": torch.tensor(sid), "load_id": torch.tensor(lid),
+                "error_estimate": torch.as_tensor(self.error_estimates[i])}
         if self.with_mesh:
             item.update(nodes=torch.as_tensor(s.nodes), u_mesh=torch.as_tensor(s.displacement),
                         cells=torch.as_tensor(s.cells), n_points=torch.tensor(len(s.nodes)))
@@ -162,8 +177,8 @@ class PointCloudDataset(_Base):
 
     _fields = ("sdf", "dirichlet_distance", "", "displacement")
 
-    def __init__(self, path, split="train", normalize=None, dtype=torch.float32, with_mesh=False):
-        super().__init__(path, split, normalize, dtype, with_mesh)
+    def __init__(self, path, split="train", normalize=None, dtype=torch.float32, with_mesh=False, max_error=None):
+        super().__init__(path, split, normalize, dtype, with_mesh, max_error)
         s = None
         if self.index:
             s = self.reader.shape(self.index[0][0])
@@ -180,7 +195,7 @@ class PointCloudDataset(_Base):
         y = (torch.as_tensor(s.displacement, dtype=self.dtype) - self.y_mean) / self.y_std
         item = {"pos": torch.as_tensor(s.nodes, dtype=self.dtype), "x": x, "y": y,
                 "n_points": torch.tensor(len(s.nodes)), "shape_id": torch.tensor(sid),
-                "load_id": torch.tensor(lid)}
+                "load_id": torch.tensor(lid), "error_estimate": torch.as_tensor(self.error_estimates[i])}
         if self.with_mesh:
             item["cells"] = torch.as_tensor(s.cells)
         return item

@@ -381,7 +381,8 @@ void parse_representations(const YamlBlock& top, const std::string& source, Data
       r.fail("grid_size", c.shapes.dim == 2 ? "must be in [2, 4096]" : "must be in [2, 512]");
     rep.grid_size = int(n);
   }
-  r.allowed("point_cloud, grid, grid_size");
+  rep.error_estimate = flag(r, "error_estimate", false);
+  r.allowed("point_cloud, grid, grid_size, error_estimate");
   r.check_all_used();
 }
 

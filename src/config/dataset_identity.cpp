@@ -66,6 +66,7 @@ std::string canonical_text(const DatasetConfig& c) {
   t += fmt::format("degree: {}\nrepresentations: [{}, {}, {}]\nsplit: [{}, {}, {}]\nshard_size: {}\n", c.degree,
                    r.point_cloud, r.grid, r.grid_size, num(c.split.train), num(c.split.val), num(c.split.test),
                    c.shard_size);
+  if (r.error_estimate) t += "error_estimate: true\n";  // only when asked for: older datasets keep their identity
   t += solver_text(c.solver);
   // PETSc options in a fixed order (the order they are written in does not matter).
   auto petsc = c.petsc;

@@ -284,6 +284,7 @@ void add_to_report(const ShapeJobResult& r, RunReport& rep) {
   rep.shapes += 1;
   rep.shapes_failed += r.entry.ok ? 0 : 1;
   rep.counters += r.counters;
+  rep.label_error += r.label_error;
 }
 
 /// The run report's numbers over `comm`: counters summed over the group roots (each holds its
@@ -307,8 +308,9 @@ void reduce_report(MPI_Comm comm, bool group_root, const core::PhaseTimes& times
   rep.shapes_failed = sum_roots(rep.shapes_failed);
   rep.counters.sum_over(comm, group_root);
   rep.shards_written = sum_roots(shards_written);
+  rep.label_error.sum_over(comm, group_root);
   const std::vector<std::string> phases = {"shape", "mesh", "setup", "solve", "alpha_search",
-                                           "representations", "gather", "io"};
+                                           "error_estimate", "representations", "gather", "io"};
   for (const auto& p : phases) {
     double x = group_root ? times.get(p) : 0, total = 0;
     MPI_Allreduce(&x, &total, 1, MPI_DOUBLE, MPI_SUM, comm);
@@ -345,6 +347,7 @@ bool report_and_index(const config::DatasetConfig& cfg, const GenerateOptions& o
   j["load_cases"] = {{"converged", c.loads_ok}, {"failed", c.loads_failed},
                      {"per_second", double(c.loads()) / std::max(1e-9, rep.seconds)}};
   j["solver"] = c.solver_json();
+  j["label_error_estimate"] = rep.label_error.json();
   j["seconds"] = {{"wall", rep.seconds}, {"phases_summed_over_groups", rep.phase_seconds},
                   {"factorization_PCSetUp_summed_over_ranks", rep.factorization_seconds}};
   j["peak_rss_mib_per_rank"] = rss;
@@ -535,6 +538,7 @@ std::string report_table(const RunReport& r) {
   for (const auto& [k, v] : r.phase_seconds)
     s += fmt::format("  {:<17s} {:8.2f}  {:5.1f}%\n", k, v, 100 * v / std::max(1e-9, total));
   s += fmt::format("  (factorisations, PCSetUp: {:.2f} s of solve + alpha_search)\n", r.factorization_seconds);
+  s += r.label_error.line();
   return s;
 }
 

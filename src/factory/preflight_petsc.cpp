@@ -3,6 +3,7 @@
 
 #include "hypershape/core/error.hpp"
 #include "hypershape/factory/dataset_scene.hpp"
+#include "hypershape/factory/label_error.hpp"
 #include "hypershape/factory/preflight.hpp"
 #include "hypershape/mesh/gmsh_mesher.hpp"
 #include "hypershape/solver/nonlinear.hpp"
@@ -31,7 +32,12 @@ void trial_solve(const config::DatasetConfig& cfg) {
   lc.more_directions.assign(n, lc.direction);
   ShapeProblem sp = make_shape_problem(PETSC_COMM_SELF, cfg, shape, lc);
   solver::NonlinearSolver nl(*sp.problem, cfg.solver);
-  (void)nl.solve_for_target(lc.target);
+  const auto r = nl.solve_for_target(lc.target);
+  // The labels' error estimate (when the dataset asks for it) reads -error_estimate_order and
+  // the -error_estimate_ksp_* options.
+  LabelErrors errors(cfg, 1);
+  if (r.converged && errors.enabled())
+    errors.estimate(PETSC_COMM_SELF, cfg, shape, lc, lc, *sp.problem, nl.solution(), r.alpha);
 }
 
 /// Options PETSc reads only in PetscFinalize (or at start-up, for the whole process): no

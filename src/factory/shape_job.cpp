@@ -9,6 +9,7 @@
 
 #include "hypershape/core/error.hpp"
 #include "hypershape/factory/dataset_schema.hpp"
+#include "hypershape/factory/label_error.hpp"
 #include "hypershape/factory/load_cases.hpp"
 #include "hypershape/factory/shape_pipeline.hpp"
 #include "hypershape/factory/shape_set.hpp"
@@ -461,6 +462,7 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
   LoadTable table(n_loads, cfg.shapes.dim);
   LoadFields load_fields(*sp.problem, cfg, fields, n_loads);
   DrawnParams drawn(cfg, shape_id, n_loads);
+  LabelErrors label_errors(cfg, n_loads);
   if (root) load_fields.allocate();
   for (int l = 0; l < n_loads; ++l) {
     const auto L = std::size_t(l);
@@ -475,6 +477,10 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
     if (on_load) on_load(o.ok);
     if (!o.ok) continue;  // the row and the fields stay zero: never NaN
     table.max_u[L] = o.max_u, table.min_det[L] = o.min_det, table.alpha[L] = o.result.alpha;
+    {
+      auto t = out.times.scope("error_estimate");
+      label_errors.estimate(group, cfg, *shape, cases[0], cases[L], *sp.problem, nl->solution(), o.result.alpha);
+    }
     if (!root) continue;
     auto t = out.times.scope("representations");
     load_fields.fill(*sp.problem, L, table.alpha[L], o.u.values, moments);
@@ -484,6 +490,8 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
     auto t = out.times.scope("representations");
     table.store(arrays, n_tractions(cfg) > 0);
     load_fields.store(arrays);
+    label_errors.store(arrays);
+    out.label_error = label_errors.summary(table.status);
     drawn.store(arrays);
     moments.store(arrays);
     out.entry.load_reasons = std::move(table.reasons);

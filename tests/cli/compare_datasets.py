@@ -5,7 +5,10 @@ from the arrays), splits.json and stats.json. Exit 0 if identical, 1 with the di
 
   compare_datasets.py A B             bit for bit
   compare_datasets.py A B --rtol R    floating-point values within R * max|value| of the array
-                                      (solver groups of several ranks sum in another order)"""
+                                      (solver groups of several ranks sum in another order;
+                                      the labels' error estimates, loads/error_estimate_*, are
+                                      then only checked to be present with the same shape: see
+                                      ESTIMATE_NOTE)"""
 import json
 import os
 import sys
@@ -23,9 +26,15 @@ def walk(group, prefix=""):
 
 
 RTOL = 0.0
+# The error estimates come from GMRES at rtol 1e-2 and an energy line search on the refined mesh
+# (src/solver/error_estimate.cpp): another partition changes them by 5e-3 typically, by 25% on
+# a hard load case of the tiny h 0.1 dataset, and may turn one into -1 (no estimate). They are
+# bit for bit on any number of ranks with solver groups of one rank (the default).
+ESTIMATE_NOTE = "error estimates not compared under --rtol (partition-dependent)"
 
 
 def same(x, y):
+    rtol = RTOL
     x, y = np.asarray(x), np.asarray(y)
     if x.shape != y.shape or x.dtype != y.dtype:
         return False
@@ -35,8 +44,8 @@ def same(x, y):
         if not np.array_equal(nx, ny):
             return False
         x, y = x[~nx], y[~ny]
-    if RTOL > 0 and x.dtype.kind == "f" and x.size:
-        return bool(np.all(np.abs(x - y) <= RTOL * max(np.abs(x).max(), 1e-300)))
+    if rtol > 0 and x.dtype.kind == "f" and x.size:
+        return bool(np.all(np.abs(x - y) <= rtol * max(np.abs(x).max(), 1e-300)))
     return bool(np.array_equal(x, y))
 
 
@@ -63,6 +72,10 @@ def compare_h5(a, b, errors):
                 errors.append(f"{a}:{path}: attribute {k} differs")
         if isinstance(x, h5py.Dataset):
             n += 1
+            if RTOL > 0 and "/error_estimate_" in path:
+                if x.shape != y.shape:
+                    errors.append(f"{a}:{path}: shapes differ")
+                continue
             if not same(x[()], y[()]):
                 errors.append(f"{a}:{path}: values differ")
     for k in set(fa.attrs) | set(fb.attrs):
@@ -90,7 +103,8 @@ def main(da, db):
             errors.append(f"{name} differs")
     for e in errors[:20]:
         print("DIFF", e)
-    print(f"compared {len(sa)} shards, {n} arrays: {'identical' if not errors else f'{len(errors)} differences'}")
+    note = f" ({ESTIMATE_NOTE})" if RTOL > 0 else ""
+    print(f"compared {len(sa)} shards, {n} arrays: {'identical' if not errors else f'{len(errors)} differences'}{note}")
     return 0 if not errors else 1
 
 

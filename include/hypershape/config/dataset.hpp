@@ -81,6 +81,7 @@ struct RepresentationsConfig {
   bool point_cloud = true;
   bool grid = true;
   int grid_size = 0;          ///< points per axis; 0 until resolved (128 in 2D, 64 in 3D)
+  bool error_estimate = false;  ///< loads/error_estimate_*: each label's estimated error (costs about a solve)
 };
 
 struct SplitConfig {

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "hypershape/config/dataset.hpp"
+#include "hypershape/factory/label_error.hpp"
 #include "hypershape/factory/solve_counters.hpp"
 
 namespace hypershape::factory {
@@ -44,6 +45,7 @@ struct RunReport {
   double seconds = 0;
   std::map<std::string, double> phase_seconds;  ///< summed over group roots
   double factorization_seconds = 0;             ///< PCSetUp, summed over ranks
+  LabelErrorSummary label_error;  ///< the labels' error estimates over the converged load cases
   std::string json;                              ///< the report as written (rank 0)
   bool indexed = false;                          ///< manifest written (dataset complete)
 };

@@ -1,0 +1,80 @@
+#pragma once
+/// The error estimate of a dataset's labels (solver::TwoLevelEstimator) on one shape: the
+/// shape's mesh refined once, the dataset's scene built on it (same degree), set to each load
+/// case in turn. Built once per shape, on the shape's solver group.
+#include <mpi.h>
+
+#include <cstdint>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "hypershape/config/dataset.hpp"
+#include "hypershape/factory/dataset_scene.hpp"
+#include "hypershape/factory/load_cases.hpp"
+#include "hypershape/factory/shape_pipeline.hpp"
+#include "hypershape/io/dataset_shard.hpp"
+#include "hypershape/mesh/refine.hpp"
+#include "hypershape/solver/error_estimate.hpp"
+
+namespace hypershape::factory {
+
+class LabelErrorEstimator {
+ public:
+  /// `coarse`: the shape's problem (built by make_shape_problem from `shape`). Collective over
+  /// `group`.
+  LabelErrorEstimator(MPI_Comm group, const config::DatasetConfig& cfg, const ShapeSample& shape,
+                      const LoadCase& first, const physics::Problem& coarse);
+  /// Sets the fine problem to load case `lc` and estimates the error of `u` at `alpha`.
+  /// Collective.
+  solver::ErrorEstimate estimate(const config::DatasetConfig& cfg, const LoadCase& lc, Vec u, double alpha);
+  const physics::Problem& fine() const { return *fine_.problem; }
+  const mesh::RefinedMesh& refined() const { return refined_; }
+  const solver::TwoLevelEstimator& estimator() const { return *estimator_; }
+
+ private:
+  mesh::RefinedMesh refined_;
+  ShapeSample fine_shape_;
+  ShapeProblem fine_;
+  std::unique_ptr<solver::TwoLevelEstimator> estimator_;
+};
+
+/// The labels' estimated errors (loads/error_estimate_rel_l2) over converged load cases: a
+/// shape's, a task's run report's; += to sum, sum_over to reduce over the group roots.
+struct LabelErrorSummary {
+  std::int64_t n = 0, missing = 0, above_1_percent = 0, above_5_percent = 0;  ///< missing: -1 stored
+  double sum = 0, max = 0;
+  LabelErrorSummary& operator+=(const LabelErrorSummary& o);
+  /// Summed (max: maximum) over `comm`, counting only the ranks where `contribute`. Collective.
+  void sum_over(MPI_Comm comm, bool contribute);
+  nlohmann::json json() const;
+  std::string line() const;  ///< one line of the printed report ("" when no estimate)
+};
+
+/// The per-load-case estimates of one shape, as the shape job stores them
+/// (loads/error_estimate_rel_l2, _max_u, _alpha; 0 for a load case that failed, -1 in all
+/// three for a converged one whose estimate could not be formed: the fine Newton step found
+/// no descent, e.g. a state the refined mesh does not hold stable). The estimator is built at
+/// the first converged load case.
+/// On when the dataset asks for it (representations.error_estimate).
+class LabelErrors {
+ public:
+  LabelErrors(const config::DatasetConfig& cfg, int n_loads);
+  /// Estimates load case `lc` (converged: u at alpha). Collective over `group`; a failure
+  /// leaves -1 (a PETSc error is logged), never thrown.
+  void estimate(MPI_Comm group, const config::DatasetConfig& cfg, const ShapeSample& shape, const LoadCase& first,
+                const LoadCase& lc, const physics::Problem& coarse, Vec u, double alpha);
+  /// Appends the three arrays (group root).
+  void store(std::vector<io::Array>& arrays) const;
+  bool enabled() const { return enabled_; }
+  /// Over the converged load cases (status 1).
+  LabelErrorSummary summary(const std::vector<std::int8_t>& status) const;
+
+ private:
+  bool enabled_ = true;
+  std::unique_ptr<LabelErrorEstimator> estimator_;
+  std::vector<double> rel_l2_, max_u_, alpha_;
+};
+
+}  // namespace hypershape::factory

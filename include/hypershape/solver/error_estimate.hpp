@@ -1,0 +1,87 @@
+#pragma once
+/// A posteriori error estimate of a solved load case: the two-level estimate.
+///
+/// The solution u_h of the coarse problem is prolonged exactly (P, nested spaces) to the same
+/// scene on the uniformly refined mesh (mesh::refine_uniform, same degree), and one Newton step
+/// of the fine problem is taken from there at the same load:
+///   K_f(P u_h) e = -R_f(P u_h),
+/// solved by CG with a two-grid preconditioner (PCMG: the coarse tangent K_c(u_h), factorised
+/// once, as the coarse level, P as the interpolation, Chebyshev/Jacobi smoothing on the fine
+/// level; a few tens of iterations, no fine factorisation). P u_h + e is the fine solution
+/// u_{h/2} to second order, so e estimates u_{h/2} - u_h, and
+///   u - u_h ~ theta e,   theta = 1 / (1 - 2^-q)
+/// for an error falling like h^q (q: -error_estimate_order, default 1: the order measured for
+/// the clamp ends' singularity at nu 0.49, docs/ACCURACY.md). The stored estimates are
+///   rel_l2 = theta ||e||_L2 / ||P u_h + theta e||_L2    (function norms over the body)
+///   max_u  = (max|P u_h + theta e| - max|P u_h|) / max|P u_h|   (fine nodes; signed)
+///   alpha  = -max_u max|u_h| / (alpha dmax/dalpha)       (signed: the traction for the target)
+/// A first try solved the tangent on the new dofs only (the hierarchical estimate, CG + Jacobi):
+/// it missed the global, too-stiff part of the error (100x too small on Random2D, docs/ACCURACY.md).
+#include <memory>
+#include <vector>
+
+#include "hypershape/core/petsc_handle.hpp"
+#include "hypershape/mesh/refine.hpp"
+#include "hypershape/physics/problem.hpp"
+
+namespace hypershape::solver {
+
+struct ErrorEstimate {
+  bool ok = false;           ///< false: the estimate could not be formed (values 0)
+  double rel_l2 = 0;         ///< relative L2 error of u (function norm)
+  double max_u = 0;          ///< relative error of max|u|, signed
+  double alpha = 0;          ///< relative error of alpha for the stored target, signed
+  double raw_rel_l2 = 0;     ///< ||e|| / ||P u_h + e|| (theta = 1)
+  double raw_max_u = 0;      ///< max_u with theta = 1
+  double slope = 0;          ///< dmax|u| / dalpha used for the alpha estimate
+  int krylov_iterations = 0;
+  bool newton_steps_converged = false;  ///< one full Newton step, or steps to 1% of the first residual
+  int residual_assemblies = 0, tangent_assemblies = 0, factorizations = 0;
+  double seconds = 0;
+  double seconds_assembly = 0, seconds_linear = 0;  ///< parts of `seconds`: fine residuals and tangents; the fine solves
+};
+
+/// The exact L2 norm squared of a P1/P2 nodal field (n_comp components, canonical node order)
+/// on straight-sided simplices given by `coords` and `cells` (VTK order). Not collective.
+double l2_norm_squared(int dim, int degree, const std::vector<double>& coords,
+                       const std::vector<std::int64_t>& cells, const std::vector<double>& field, int n_comp);
+
+class TwoLevelEstimator {
+ public:
+  /// `coarse`: the solved problem; `fine`: the same scene on `refined.mesh` (same degree), whose
+  /// coarse mesh is the one `coarse` was built from. Builds P. Collective over the problems'
+  /// communicator (the same for both). The linear solve reads PETSc options with prefix
+  /// "error_estimate_" (-error_estimate_ksp_rtol, -error_estimate_mg_levels_ksp_max_it, ...).
+  TwoLevelEstimator(const physics::Problem& coarse, const physics::Problem& fine, const mesh::RefinedMesh& refined);
+  ~TwoLevelEstimator();
+  TwoLevelEstimator(const TwoLevelEstimator&) = delete;
+  TwoLevelEstimator& operator=(const TwoLevelEstimator&) = delete;
+
+  /// Estimates the error of `u_h` (a global vector of the coarse problem) at load factor
+  /// `alpha`; the fine problem must carry the same load case. Collective. Never throws for a
+  /// numerical failure (ok = false); PETSc errors throw core::PetscError.
+  ErrorEstimate estimate(Vec u_h, double alpha) const;
+
+  /// P u: a coarse global vector prolonged into a fine global vector. Collective.
+  void prolong(Vec coarse, Vec fine) const;
+  /// The same on canonical nodal arrays (rank 0; empty elsewhere). Not collective.
+  std::vector<double> prolong(const std::vector<double>& coarse_values) const;
+  Mat interpolation() const { return P_.get(); }
+
+ private:
+  /// Newton on the fine problem from P u_h (the two-grid solver set up): e = u_fine - P u_h.
+  bool fine_newton(Vec Pu, double alpha, Vec e, ErrorEstimate& out) const;
+  const physics::Problem& coarse_;
+  const physics::Problem& fine_;
+  /// Prolongation in canonical numbering (every rank): fine node i = sum_k w[k] coarse node
+  /// col[k], k in [row[i], row[i+1]).
+  std::vector<std::int64_t> row_, col_;
+  std::vector<double> w_;
+  core::MatH P_;                 ///< the same in global dofs (constrained dofs dropped)
+  mutable core::MatH Kf_, Kc_;  ///< fine and coarse tangents, allocated at the first estimate
+  /// The two-grid solver, kept: the coarse factorisation's symbolic phase (ordering) is done
+  /// once per shape, each estimate refactorises numerically only.
+  mutable core::KSPH ksp_;
+};
+
+}  // namespace hypershape::solver

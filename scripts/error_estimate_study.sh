@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# The validation of the labels' error estimate in docs/ACCURACY.md ("Every label knows its own
+# error"): build/study_error_estimate on the accuracy study's scenes and on random Random2D /
+# Random3D load cases, then scripts/error_estimate_report.py (table + log-log plot).
+#   scripts/error_estimate_study.sh [PART...]    parts: random2d scenes2d p2 random3d scenes3d report
+#                                                (default: all; each appends to results/error_estimate/PART.jsonl)
+# One rank, OPENBLAS_NUM_THREADS=1; references with MUMPS (-ref_ prefix). Runtime on the shared
+# 2-core VM: random2d ~10 min, scenes2d ~5, p2 ~10, random3d/scenes3d ~10 each.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+BIN=${BIN:-build/study_error_estimate}
+OUT=${OUT:-results/error_estimate}
+mkdir -p "$OUT" docs/figures
+export OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
+ref=(-ref_pc_factor_mat_solver_type mumps)
+parts=("$@")
+[ ${#parts[@]} -gt 0 ] || parts=(random2d scenes2d p2 random3d scenes3d report)
+for part in "${parts[@]}"; do
+  case $part in
+    random2d)  # 17 Random2D shapes x 3 load cases, as the preset generates them (P1, h 0.04)
+      "$BIN" --preset random2d --shapes $(seq 0 16) --loads 3 --out "$OUT/random2d.jsonl" -- "${ref[@]}" ;;
+    scenes2d)  # the accuracy study's 2D scenes at their presets' settings, targets 0.1 0.3 0.5
+      for s in disk r2d-0 r2d-1 ood-0 easy-0; do "$BIN" --scene $s --out "$OUT/scenes2d.jsonl" -- "${ref[@]}"; done ;;
+    p2)        # P2 on the same scenes at h 0.08 (references P2 at h 0.04 and 0.02)
+      for s in disk r2d-0 r2d-1 ood-0; do "$BIN" --scene $s --degree 2 --h 0.08 --out "$OUT/p2.jsonl" -- "${ref[@]}"; done ;;
+    random3d)  # Random3D shapes (P2) as the preset solves them, coarser (mesh.h 0.5) so that a
+               # reference two refinements finer stays within reach of one core
+      "$BIN" --preset random3d --h 0.5 --shapes 0 1 2 3 4 --loads 2 --levels 2 --out "$OUT/random3d.jsonl" -- "${ref[@]}" ;;
+    scenes3d)
+      "$BIN" --scene ball --h 0.5 --levels 2 --out "$OUT/scenes3d.jsonl" -- "${ref[@]}" ;;
+    report)
+      /usr/bin/python3 scripts/error_estimate_report.py "$OUT"/*.jsonl --plot docs/figures/error_estimate.png ;;
+    *) echo "unknown part $part" >&2; exit 2 ;;
+  esac
+done

@@ -1,0 +1,190 @@
+/// The labels' error estimate (solver::TwoLevelEstimator, mesh::refine_uniform):
+///  - the refinement is nested and the prolongation exact (P1 and P2 fields of the coarse
+///    space are reproduced at every fine node);
+///  - a solution the space contains (the homogeneous deformation of the unit square under a
+///    uniform dead traction) has a zero estimate (round-off);
+///  - on the manufactured finite-strain solution of test_mms (smooth: the error falls like
+///    h^(p+1), so -error_estimate_order p+1) the estimate falls at that rate and stays within
+///    [0.5, 2] of the true error.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+
+#include "hypershape/mesh/refine.hpp"
+#include "hypershape/solver/error_estimate.hpp"
+#include "hypershape/physics/neo_hookean.hpp"
+#include "support/helpers.hpp"
+
+using namespace hypershape;
+
+namespace {
+
+constexpr double pi = std::numbers::pi;
+
+using EffectsMaker = std::function<std::vector<physics::EffectPtr>()>;
+
+struct Pair {
+  mesh::RefinedMesh refined;
+  std::unique_ptr<physics::Problem> coarse, fine;
+  std::unique_ptr<solver::TwoLevelEstimator> est;
+};
+
+Pair make_pair(const mesh::MeshData& m, int degree, const EffectsMaker& effects) {
+  Pair p;
+  p.refined = mesh::refine_uniform(m);
+  physics::SpaceOptions so = hstest::degree(degree);
+  p.coarse = std::make_unique<physics::Problem>(PETSC_COMM_WORLD, m, effects(), so);
+  p.fine = std::make_unique<physics::Problem>(PETSC_COMM_WORLD, p.refined.mesh, effects(), so);
+  p.est = std::make_unique<solver::TwoLevelEstimator>(*p.coarse, *p.fine, p.refined);
+  return p;
+}
+
+/// u* of test_mms (2D): (0.12 sin(pi x) sin(pi y), 0.06 sin(2 pi x) sin(pi y)) and its body force
+/// for the Neo-Hookean material (E 500, nu 0.3).
+struct Mms {
+  physics::NeoHookean<2> mat{physics::Lame::from_young_poisson(500, 0.3).mu,
+                             physics::Lame::from_young_poisson(500, 0.3).lambda};
+  double A[2] = {0.12, 0.06};
+  int k[2][2] = {{1, 1}, {2, 1}};
+  void value(const double* x, double* u) const {
+    for (int i = 0; i < 2; ++i) u[i] = A[i] * std::sin(k[i][0] * pi * x[0]) * std::sin(k[i][1] * pi * x[1]);
+  }
+  void body_force(const double* x, double* b) const {
+    physics::Tensor<2> G;
+    double H[2][2][2];
+    for (int i = 0; i < 2; ++i) {
+      const double a = k[i][0] * pi, c = k[i][1] * pi, sx = std::sin(a * x[0]), sy = std::sin(c * x[1]),
+                   cx = std::cos(a * x[0]), cy = std::cos(c * x[1]);
+      G(i, 0) = A[i] * a * cx * sy, G(i, 1) = A[i] * c * sx * cy;
+      H[i][0][0] = -A[i] * a * a * sx * sy, H[i][1][1] = -A[i] * c * c * sx * sy;
+      H[i][0][1] = H[i][1][0] = A[i] * a * c * cx * cy;
+    }
+    physics::Tensor<2> P;
+    physics::Tangent<2> At;
+    const physics::Tensor<2> F = physics::Tensor<2>::Identity() + G;
+    REQUIRE(mat.stress_tangent(F, P, At));
+    for (int i = 0; i < 2; ++i) {
+      b[i] = 0;
+      for (int J = 0; J < 2; ++J)
+        for (int kk = 0; kk < 2; ++kk)
+          for (int L = 0; L < 2; ++L) b[i] -= At(i * 2 + J, kk * 2 + L) * H[kk][L][J];
+    }
+  }
+};
+
+}  // namespace
+
+TEST_CASE("Uniform refinement is nested and the prolongation exact", "[error_estimate]") {
+  for (int dim : {2, 3})
+    for (int deg : {1, 2}) {
+      DYNAMIC_SECTION(dim << "D P" << deg) {
+        const mesh::MeshData m = mesh::mesh_box(dim, 1.0, dim == 2 ? 0.3 : 0.6);
+        auto effects = [dim] {
+          std::vector<physics::EffectPtr> e;
+          e.push_back(physics::make_neo_hookean(500, 0.3));
+          e.push_back(physics::make_dirichlet("clamp", hstest::on_plane(0, 0.0)));
+          (void)dim;
+          return e;
+        };
+        Pair p = make_pair(m, deg, effects);
+        CHECK(p.refined.mesh.n_cells() == m.n_cells() * (dim == 2 ? 4 : 8));
+        CHECK(hstest::domain_measure(*p.fine) == Approx(1.0).epsilon(1e-12));
+        CHECK(p.fine->space().min_det_jacobian() > 0);
+        // A field of the space (linear for P1, quadratic for P2) that vanishes on the clamped
+        // face x = 0: the prolonged coarse interpolant must equal the fine interpolant at every
+        // fine node.
+        auto f = [deg](const double* x, double* u) {
+          const double q = deg == 2 ? 1.0 : 0.0;
+          u[0] = x[0] * (0.3 + q * (0.5 * x[1] - 0.2 * x[0]));
+          u[1] = x[0] * (-0.4 + q * 0.25 * x[1]);
+          u[2] = x[0] * (0.2 + q * 0.3 * x[0]);
+        };
+        core::VecH uc = p.coarse->create_vector(), uf = p.fine->create_vector();
+        hstest::interpolate(*p.coarse, f, uc);
+        hstest::interpolate(*p.fine, f, uf);
+        const auto prolonged = p.est->prolong(p.coarse->gather(uc).values);
+        const auto direct = p.fine->gather(uf).values;
+        REQUIRE(prolonged.size() == direct.size());
+        double worst = 0;
+        for (std::size_t i = 0; i < direct.size(); ++i) worst = std::max(worst, std::abs(prolonged[i] - direct[i]));
+        CHECK(worst < 1e-13);
+      }
+    }
+}
+
+TEST_CASE("The estimate of a solution the space contains is zero", "[error_estimate]") {
+  for (int deg : {1, 2}) {
+    DYNAMIC_SECTION("2D P" << deg) {
+      const double T = 40.0;  // a finite stretch of the Neo-Hookean square
+      auto effects = [T] {
+        std::vector<physics::EffectPtr> e;
+        e.push_back(physics::make_neo_hookean(500, 0.3));
+        e.push_back(physics::make_dirichlet("roller_x", hstest::on_plane(0, 0.0), {0}));
+        e.push_back(physics::make_dirichlet("roller_y", hstest::on_plane(1, 0.0), {1}));
+        e.push_back(physics::make_surface_traction([T](const double*, double* t) { t[0] = T, t[1] = 0; },
+                                                   hstest::on_plane(0, 1.0)));
+        return e;
+      };
+      Pair p = make_pair(mesh::mesh_box(2, 1.0, 0.25), deg, effects);
+      solver::SolverOptions so;
+      so.rtol = 1e-12;
+      solver::NonlinearSolver ns(*p.coarse, so);
+      REQUIRE(ns.solve(1.0).converged);
+      REQUIRE(p.coarse->max_displacement(ns.solution()) > 0.05);
+      const solver::ErrorEstimate e = p.est->estimate(ns.solution(), 1.0);
+      REQUIRE(e.ok);
+      INFO("rel_l2 " << e.rel_l2 << " max_u " << e.max_u << " alpha " << e.alpha);
+      CHECK(e.rel_l2 < 1e-9);
+      CHECK(std::abs(e.max_u) < 1e-9);
+      CHECK(std::abs(e.alpha) < 1e-9);
+      CHECK(e.krylov_iterations >= 0);
+    }
+  }
+}
+
+TEST_CASE("The estimate of the manufactured solution converges at the L2 rate", "[error_estimate]") {
+  const Mms ms;
+  for (int deg : {1, 2}) {
+    DYNAMIC_SECTION("2D P" << deg) {
+      std::vector<double> est, truth;
+      const std::vector<double> hs = deg == 1 ? std::vector<double>{1.0 / 8, 1.0 / 16, 1.0 / 32}
+                                              : std::vector<double>{1.0 / 4, 1.0 / 8, 1.0 / 16};
+      HS_PETSC(PetscOptionsSetValue(nullptr, "-error_estimate_order", deg == 1 ? "2" : "3"));
+      for (double h : hs) {
+        auto effects = [&ms] {
+          std::vector<physics::EffectPtr> e;
+          e.push_back(physics::make_neo_hookean(500, 0.3));
+          e.push_back(physics::make_dirichlet("clamp", hstest::everywhere()));
+          e.push_back(physics::make_body_force([&ms](const double* x, double* b) { ms.body_force(x, b); }));
+          return e;
+        };
+        Pair p = make_pair(mesh::mesh_box(2, 1.0, h), deg, effects);
+        solver::SolverOptions so;
+        so.rtol = 1e-11;
+        solver::NonlinearSolver ns(*p.coarse, so);
+        REQUIRE(ns.solve(1.0).converged);
+        const auto e = p.est->estimate(ns.solution(), 1.0);
+        REQUIRE(e.ok);
+        core::VecH ue = p.coarse->create_vector();
+        hstest::interpolate(*p.coarse, [&ms](const double* x, double* u) { ms.value(x, u); }, ue);
+        const double u_norm = std::sqrt(0.25 * (ms.A[0] * ms.A[0] + ms.A[1] * ms.A[1]));
+        est.push_back(e.rel_l2);
+        truth.push_back(hstest::l2_error(*p.coarse, ns.solution(), [&ms](const double* x, double* u) { ms.value(x, u); }) /
+                        u_norm);
+        std::printf("P%d h %-8.4g estimate %-10.4e true %-10.4e effectivity %.3f (CG %d its)\n", deg, h, est.back(),
+                    truth.back(), est.back() / truth.back(), e.krylov_iterations);
+      }
+      HS_PETSC(PetscOptionsClearValue(nullptr, "-error_estimate_order"));
+      const std::size_t n = est.size();
+      const double rate = std::log2(est[n - 2] / est[n - 1]);
+      INFO("estimate rate " << rate);
+      CHECK(rate > deg + 1 - 0.3);
+      CHECK(rate < deg + 1 + 0.5);
+      for (std::size_t i = 0; i < n; ++i) {
+        CHECK(est[i] / truth[i] > 0.5);
+        CHECK(est[i] / truth[i] < 2.0);
+      }
+    }
+  }
+}
