@@ -133,212 +133,243 @@ Vector face_normal(const Mesh& m, HI h) {
   return CGAL::cross_product(b - a, c - a);
 }
 
-/// Cuts `m` along the sphere |x - c| = r and remeshes it with the cut curve as a constraint.
-void remesh_with_clamp(Mesh& m, const RemeshOptions& opt, const std::vector<K::Triangle_3>& input) {
-  const Point c((*opt.clamp_center)[0], (*opt.clamp_center)[1], (*opt.clamp_center)[2]);
-  const double r = opt.clamp_radius, h = opt.target_edge;
-  const double snap = std::max(1e-3 * h, 1e-8 * r);
-  auto on_sphere = [&](const Point& x) {
-    const Vector u = x - c;
-    const double d = std::sqrt(u.squared_length());
-    return d > 0 ? c + u * (r / d) : x;
-  };
+/// The cut of a surface mesh along the clamp sphere |x - c| = r and its remeshing with the cut
+/// curve as a constraint: remesh_with_clamp's steps, in the order it calls them.
+class ClampCut {
+ public:
+  ClampCut(Mesh& m, const RemeshOptions& opt)
+      : m_(m), opt_(opt), c_((*opt.clamp_center)[0], (*opt.clamp_center)[1], (*opt.clamp_center)[2]),
+        r_(opt.clamp_radius), h_(opt.target_edge), snap_(std::max(1e-3 * h_, 1e-8 * r_)),
+        tiny_(1e-15 * std::max(r_, 1.0)) {}
 
-  // Resolve the cut at the target scale: no edge longer than the remesher's split threshold
-  // (exact: midpoints of straight edges). Then every curve edge, a chord of one of these
-  // triangles, is short enough that the remesher never splits it, only collapses it (keeping
-  // one of its ends, which are on the sphere). PMP::split_long_edges does not re-check the edges
-  // it creates inside the split triangles, hence the passes. 1% below the threshold leaves room
-  // for the snapping below.
-  const double high = 0.99 * 4.0 / 3.0 * h;
-  for (int pass = 0; pass < 64; ++pass) {
-    std::vector<EI> long_edges;
-    for (EI e : m.edges())
-      if (CGAL::squared_distance(m.point(m.source(m.halfedge(e))),
-                                 m.point(m.target(m.halfedge(e)))) > high * high)
-        long_edges.push_back(e);
-    if (long_edges.empty()) break;
-    PMP::split_long_edges(long_edges, high, m);
-  }
-
-  // Which side of the sphere each vertex is on: -1 inside, 0 on (snapped), +1 outside.
-  auto side = m.add_property_map<VI, int>("v:hs_side", 0).first;
-  for (VI v : m.vertices()) {
-    const double d = std::sqrt(CGAL::squared_distance(m.point(v), c));
-    if (std::abs(d - r) <= snap) {
-      m.point(v) = on_sphere(m.point(v));
-      side[v] = 0;
-    } else {
-      side[v] = d < r ? -1 : 1;
+  /// Resolves the cut at the target scale: no edge longer than the remesher's split threshold
+  /// (exact: midpoints of straight edges). Then every curve edge, a chord of one of these
+  /// triangles, is short enough that the remesher never splits it, only collapses it (keeping
+  /// one of its ends, which are on the sphere). PMP::split_long_edges does not re-check the
+  /// edges it creates inside the split triangles, hence the passes. 1% below the threshold leaves
+  /// room for the snapping below.
+  void split_long_edges() {
+    const double high = 0.99 * 4.0 / 3.0 * h_;
+    for (int pass = 0; pass < 64; ++pass) {
+      std::vector<EI> long_edges;
+      for (EI e : m_.edges())
+        if (CGAL::squared_distance(m_.point(m_.source(m_.halfedge(e))), m_.point(m_.target(m_.halfedge(e)))) >
+            high * high)
+          long_edges.push_back(e);
+      if (long_edges.empty()) break;
+      PMP::split_long_edges(long_edges, high, m_);
     }
   }
 
-  // An edge with no endpoint inside may still pass through the ball (a "dip"): split it where it
-  // comes closest to the centre, so that every edge crosses the sphere at most once.
-  {
-    std::vector<EI> snapshot(m.edges().begin(), m.edges().end());
+  /// Which side of the sphere each vertex is on: -1 inside, 0 on (snapped), +1 outside.
+  void mark_sides() {
+    side_ = m_.add_property_map<VI, int>("v:hs_side", 0).first;
+    for (VI v : m_.vertices()) {
+      const double d = std::sqrt(CGAL::squared_distance(m_.point(v), c_));
+      if (std::abs(d - r_) <= snap_) {
+        m_.point(v) = on_sphere(m_.point(v));
+        side_[v] = 0;
+      } else {
+        side_[v] = d < r_ ? -1 : 1;
+      }
+    }
+  }
+
+  /// An edge with no endpoint inside may still pass through the ball (a "dip"): split it where
+  /// it comes closest to the centre, so that every edge crosses the sphere at most once.
+  void split_dips() {
+    std::vector<EI> snapshot(m_.edges().begin(), m_.edges().end());
     for (EI e : snapshot) {
-      const HI he = m.halfedge(e);
-      const VI a = m.source(he), b = m.target(he);
-      if (side[a] < 0 || side[b] < 0 || (side[a] == 0 && side[b] == 0)) continue;
-      const Point &pa = m.point(a), &pb = m.point(b);
+      const HI he = m_.halfedge(e);
+      const VI a = m_.source(he), b = m_.target(he);
+      if (side_[a] < 0 || side_[b] < 0 || (side_[a] == 0 && side_[b] == 0)) continue;
+      const Point &pa = m_.point(a), &pb = m_.point(b);
       const Vector d = pb - pa;
-      const double t = ((c - pa) * d) / d.squared_length();
+      const double t = ((c_ - pa) * d) / d.squared_length();
       if (!(t > 1e-6 && t < 1 - 1e-6)) continue;
       const Point q = pa + t * d;
-      if (std::sqrt(CGAL::squared_distance(q, c)) >= r - snap) continue;
-      side[split_edge_at(m, he, q)] = -1;
+      if (std::sqrt(CGAL::squared_distance(q, c_)) >= r_ - snap_) continue;
+      side_[split_edge_at(m_, he, q)] = -1;
     }
   }
 
-  // Split every edge whose endpoints are on opposite sides at its crossing point.
-  {
-    std::vector<EI> snapshot(m.edges().begin(), m.edges().end());
+  /// Splits every edge whose endpoints are on opposite sides at its crossing point.
+  void split_crossings() {
+    std::vector<EI> snapshot(m_.edges().begin(), m_.edges().end());
     for (EI e : snapshot) {
-      const HI he = m.halfedge(e);
-      const VI a = m.source(he), b = m.target(he);
-      if (side[a] * side[b] >= 0) continue;
-      const Point &pa = m.point(a), &pb = m.point(b);
-      const Vector d = pb - pa, w = pa - c;
+      const HI he = m_.halfedge(e);
+      const VI a = m_.source(he), b = m_.target(he);
+      if (side_[a] * side_[b] >= 0) continue;
+      const Point &pa = m_.point(a), &pb = m_.point(b);
+      const Vector d = pb - pa, w = pa - c_;
       // |w + t d|^2 = r^2: exactly one root in (0, 1) since the ends are on opposite sides.
-      const double A = d * d, B = 2 * (w * d), C = w * w - r * r;
+      const double A = d * d, B = 2 * (w * d), C = w * w - r_ * r_;
       const double disc = std::sqrt(std::max(0.0, B * B - 4 * A * C));
       const double q = -0.5 * (B + std::copysign(disc, B));
       double t1 = q / A, t2 = q != 0 ? C / q : t1;
       auto dist01 = [](double t) { return t < 0 ? -t : (t > 1 ? t - 1 : 0.0); };
       const double t = std::clamp(dist01(t1) <= dist01(t2) ? t1 : t2, 0.0, 1.0);
-      side[split_edge_at(m, he, on_sphere(pa + t * d))] = 0;
+      side_[split_edge_at(m_, he, on_sphere(pa + t * d))] = 0;
     }
   }
 
-  // The patch: faces with no vertex outside (so facets_in_ball finds exactly them). The curve:
-  // edges between a patch face and another face; both ends of such an edge are on the sphere.
-  auto patch = m.add_property_map<FI, int>("f:hs_patch", 0).first;
-  for (FI f : m.faces()) {
-    bool outside = false;
-    for (VI v : CGAL::vertices_around_face(m.halfedge(f), m)) outside |= side[v] > 0;
-    patch[f] = outside ? 0 : 1;
+  /// The patch: faces with no vertex outside (so facets_in_ball finds exactly them). The curve:
+  /// edges between a patch face and another face; both ends of such an edge are on the sphere.
+  /// Then the input surface near the curve, for moving new curve vertices back onto it.
+  void mark_patch_and_curve() {
+    patch_ = m_.add_property_map<FI, int>("f:hs_patch", 0).first;
+    for (FI f : m_.faces()) {
+      bool outside = false;
+      for (VI v : CGAL::vertices_around_face(m_.halfedge(f), m_)) outside |= side_[v] > 0;
+      patch_[f] = outside ? 0 : 1;
+    }
+    constrained_ = m_.add_property_map<EI, bool>("e:hs_clamp", false).first;
+    for (EI e : m_.edges()) {
+      const HI he = m_.halfedge(e);
+      if (patch_[m_.face(he)] != patch_[m_.face(m_.opposite(he))]) {
+        constrained_[e] = true;
+        ++n_curve_;
+      }
+    }
+    if (n_curve_ > 0) collect_band();
   }
-  auto constrained = m.add_property_map<EI, bool>("e:hs_clamp", false).first;
-  std::size_t n_curve = 0;
-  for (EI e : m.edges()) {
-    const HI he = m.halfedge(e);
-    if (patch[m.face(he)] != patch[m.face(m.opposite(he))]) {
-      constrained[e] = true;
-      ++n_curve;
+
+  /// The isotropic remeshing at h with the curve constrained, then the local refinement (if
+  /// asked for), the curve snapped back after each.
+  void remesh(const std::vector<K::Triangle_3>& input) {
+    remesh_faces(faces(m_), h_);
+    if (n_curve_ > 0) snap_curve();
+    refine_locally(
+        m_, opt_, input, [&](const std::vector<FI>& selected, double t) { remesh_faces(selected, t); },
+        [&](VI v) { return on_curve(v); },
+        [&] {
+          if (n_curve_ > 0) snap_curve();
+        });
+  }
+
+  /// A vertex off the curve on the outer side could sit inside the ball (within the sagitta of
+  /// a curve edge); push it just outside so that every outer face has a vertex outside the ball.
+  void push_outer_vertices() {
+    if (n_curve_ == 0) return;
+    for (FI f : m_.faces()) {
+      if (patch_[f] != 0) continue;
+      bool has_outside = false;
+      for (VI v : CGAL::vertices_around_face(m_.halfedge(f), m_))
+        has_outside |= std::sqrt(CGAL::squared_distance(m_.point(v), c_)) > r_ * (1 + 1e-9);
+      if (has_outside) continue;
+      for (VI v : CGAL::vertices_around_face(m_.halfedge(f), m_)) {
+        if (on_curve(v)) continue;
+        const Vector u = m_.point(v) - c_;
+        m_.point(v) = c_ + u * (r_ * (1 + 1e-6) / std::sqrt(u.squared_length()));
+        has_outside = true;
+        break;
+      }
+      if (!has_outside)
+        throw std::runtime_error(
+            "remesh_surface: a triangle outside the clamp patch has all its "
+            "vertices on the clamp curve; the target edge is too coarse for "
+            "the clamp radius");
     }
   }
 
-  // The input surface near the curve, for moving new curve vertices back onto it.
-  std::vector<K::Triangle_3> band;
-  if (n_curve > 0)
-    for (FI f : m.faces()) {
+ private:
+  Point on_sphere(const Point& x) const {
+    const Vector u = x - c_;
+    const double d = std::sqrt(u.squared_length());
+    return d > 0 ? c_ + u * (r_ / d) : x;
+  }
+  bool on_curve(VI v) const {
+    for (HI he : CGAL::halfedges_around_target(v, m_))
+      if (constrained_[m_.edge(he)]) return true;
+    return false;
+  }
+  template <class FaceRange>
+  void remesh_faces(const FaceRange& selected, double edge) {
+    PMP::isotropic_remeshing(selected, edge, m_,
+                             CGAL::parameters::number_of_iterations(unsigned(opt_.iterations))
+                                 .edge_is_constrained_map(constrained_)
+                                 .face_patch_map(patch_)
+                                 .protect_constraints(false)
+                                 .collapse_constraints(true)
+                                 .relax_constraints(false));
+  }
+  void collect_band() {
+    for (FI f : m_.faces()) {
       double dmin = 1e300, dmax = 0, lmax = 0;
       Point p[3];
       int k = 0;
-      for (VI v : CGAL::vertices_around_face(m.halfedge(f), m)) p[k++] = m.point(v);
+      for (VI v : CGAL::vertices_around_face(m_.halfedge(f), m_)) p[k++] = m_.point(v);
       for (int i = 0; i < 3; ++i) {
-        const double d = std::sqrt(CGAL::squared_distance(p[i], c));
+        const double d = std::sqrt(CGAL::squared_distance(p[i], c_));
         dmin = std::min(dmin, d);
         dmax = std::max(dmax, d);
         lmax = std::max(lmax, std::sqrt(CGAL::squared_distance(p[i], p[(i + 1) % 3])));
       }
-      if (dmin - lmax <= r + 2 * h && dmax >= r - 2 * h) band.emplace_back(p[0], p[1], p[2]);
+      if (dmin - lmax <= r_ + 2 * h_ && dmax >= r_ - 2 * h_) band_.emplace_back(p[0], p[1], p[2]);
     }
-
-  // Should the remesher have split a constrained edge, the new vertex is at its midpoint (inside
-  // the ball, off the surface-sphere intersection). Move each such vertex to where the input
-  // surface meets the sphere by alternating projections (they converge fast: the two surfaces cross
-  // at a clear angle for a patch centred on the surface). Done after every remesh: a curve
-  // vertex moved only after several levels of refinement would fold the small triangles around it.
-  std::optional<Tree> tree;  // built on first use: normally no vertex needs moving
-  const double tiny = 1e-15 * std::max(r, 1.0);
-  auto snap_curve = [&] {
-    for (VI v : m.vertices()) {
-      bool on_curve = false;
-      for (HI he : CGAL::halfedges_around_target(v, m)) on_curve |= constrained[m.edge(he)];
-      if (!on_curve) continue;
-      const Point x0 = m.point(v);
-      if (std::abs(std::sqrt(CGAL::squared_distance(x0, c)) - r) <= 4 * tiny) {
-        m.point(v) = on_sphere(x0);
+  }
+  /// Should the remesher have split a constrained edge, the new vertex is at its midpoint (inside
+  /// the ball, off the surface-sphere intersection). Moves each such vertex to where the input
+  /// surface meets the sphere by alternating projections (they converge fast: the two surfaces
+  /// cross at a clear angle for a patch centred on the surface). Done after every remesh: a curve
+  /// vertex moved only after several levels of refinement would fold the small triangles around it.
+  void snap_curve() {
+    for (VI v : m_.vertices()) {
+      if (!on_curve(v)) continue;
+      const Point x0 = m_.point(v);
+      if (std::abs(std::sqrt(CGAL::squared_distance(x0, c_)) - r_) <= 4 * tiny_) {
+        m_.point(v) = on_sphere(x0);
         continue;
       }
       std::vector<std::pair<HI, Vector>> normals;
-      for (HI he : CGAL::halfedges_around_target(v, m))
-        if (!m.is_border(he)) normals.emplace_back(he, face_normal(m, he));
-      if (!tree) {
-        tree.emplace(band.begin(), band.end());
-        tree->accelerate_distance_queries();
-      }
-      Point x = on_sphere(x0);
-      for (int it = 0; it < 200; ++it) {
-        const Point xn = on_sphere(tree->closest_point(x));
-        const double step = std::sqrt(CGAL::squared_distance(xn, x));
-        x = xn;
-        if (step <= tiny) break;
-      }
-      m.point(v) = x;
+      for (HI he : CGAL::halfedges_around_target(v, m_))
+        if (!m_.is_border(he)) normals.emplace_back(he, face_normal(m_, he));
+      m_.point(v) = project_to_curve(x0);
       for (auto& [he, n0] : normals)
-        if (face_normal(m, he) * n0 <= 0)
+        if (face_normal(m_, he) * n0 <= 0)
           throw std::runtime_error(
               "remesh_surface: moving a clamp-curve vertex onto the sphere "
               "folds a triangle; the target edge is too coarse for the clamp "
               "radius");
     }
-  };
-  PMP::isotropic_remeshing(faces(m), h, m,
-                           CGAL::parameters::number_of_iterations(unsigned(opt.iterations))
-                               .edge_is_constrained_map(constrained)
-                               .face_patch_map(patch)
-                               .protect_constraints(false)
-                               .collapse_constraints(true)
-                               .relax_constraints(false));
-  if (n_curve > 0) snap_curve();
-  auto on_curve_vertex = [&](VI v) {
-    for (HI he : CGAL::halfedges_around_target(v, m))
-      if (constrained[m.edge(he)]) return true;
-    return false;
-  };
-  refine_locally(
-      m, opt, input,
-      [&](const std::vector<FI>& selected, double t) {
-        PMP::isotropic_remeshing(selected, t, m,
-                                 CGAL::parameters::number_of_iterations(unsigned(opt.iterations))
-                                     .edge_is_constrained_map(constrained)
-                                     .face_patch_map(patch)
-                                     .protect_constraints(false)
-                                     .collapse_constraints(true)
-                                     .relax_constraints(false));
-      },
-      on_curve_vertex, [&] {
-        if (n_curve > 0) snap_curve();
-      });
-  if (n_curve == 0) return;
-
-
-  // A vertex off the curve on the outer side could sit inside the ball (within the sagitta of a
-  // curve edge); push it just outside so that every outer face has a vertex outside the ball.
-  for (FI f : m.faces()) {
-    if (patch[f] != 0) continue;
-    bool has_outside = false;
-    for (VI v : CGAL::vertices_around_face(m.halfedge(f), m))
-      has_outside |= std::sqrt(CGAL::squared_distance(m.point(v), c)) > r * (1 + 1e-9);
-    if (has_outside) continue;
-    for (VI v : CGAL::vertices_around_face(m.halfedge(f), m)) {
-      bool on_curve = false;
-      for (HI he : CGAL::halfedges_around_target(v, m)) on_curve |= constrained[m.edge(he)];
-      if (on_curve) continue;
-      const Vector u = m.point(v) - c;
-      m.point(v) = c + u * (r * (1 + 1e-6) / std::sqrt(u.squared_length()));
-      has_outside = true;
-      break;
-    }
-    if (!has_outside)
-      throw std::runtime_error(
-          "remesh_surface: a triangle outside the clamp patch has all its "
-          "vertices on the clamp curve; the target edge is too coarse for "
-          "the clamp radius");
   }
+  Point project_to_curve(const Point& x0) {
+    if (!tree_) {  // built on first use: normally no vertex needs moving
+      tree_.emplace(band_.begin(), band_.end());
+      tree_->accelerate_distance_queries();
+    }
+    Point x = on_sphere(x0);
+    for (int it = 0; it < 200; ++it) {
+      const Point xn = on_sphere(tree_->closest_point(x));
+      const double step = std::sqrt(CGAL::squared_distance(xn, x));
+      x = xn;
+      if (step <= tiny_) break;
+    }
+    return x;
+  }
+
+  Mesh& m_;
+  const RemeshOptions& opt_;
+  Point c_;
+  double r_, h_, snap_, tiny_;
+  Mesh::Property_map<VI, int> side_;
+  Mesh::Property_map<FI, int> patch_;
+  Mesh::Property_map<EI, bool> constrained_;
+  std::size_t n_curve_ = 0;
+  std::vector<K::Triangle_3> band_;  // the input surface near the curve
+  std::optional<Tree> tree_;
+};
+
+/// Cuts `m` along the sphere |x - c| = r and remeshes it with the cut curve as a constraint.
+void remesh_with_clamp(Mesh& m, const RemeshOptions& opt, const std::vector<K::Triangle_3>& input) {
+  ClampCut cut(m, opt);
+  cut.split_long_edges();
+  cut.mark_sides();
+  cut.split_dips();
+  cut.split_crossings();
+  cut.mark_patch_and_curve();
+  cut.remesh(input);
+  cut.push_outer_vertices();
 }
 
 }  // namespace

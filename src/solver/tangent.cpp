@@ -122,20 +122,25 @@ bool Tangent::apply_factor(Vec x, Vec y) {
 
 int Tangent::negative_eigenvalues() const { return factor().negative_eigenvalues(); }
 
-bool Tangent::krylov_solve(Vec b, Vec x, bool guess, int max_its, bool& converged) {
-  LogEvent e(events().krylov);
+KSPConvergedReason Tangent::run_krylov(KSP ksp, Vec b, Vec x, bool guess, int max_its, PetscInt& its) {
   // Relative to ||b|| also with an initial guess (PETSc's default test would take the guess's
   // residual as the reference and ask far more of a good guess than of none).
   PetscReal bn;
   HS_PETSC(VecNorm(b, NORM_2, &bn));
-  HS_PETSC(KSPSetTolerances(krylov_, 1e-30, forcing_ * bn, PETSC_DEFAULT, std::max(max_its, 1)));
-  HS_PETSC(KSPSetInitialGuessNonzero(krylov_, guess ? PETSC_TRUE : PETSC_FALSE));
-  HS_PETSC(KSPSolve(krylov_, b, x));
-  PetscInt its;
+  HS_PETSC(KSPSetTolerances(ksp, 1e-30, forcing_ * bn, PETSC_DEFAULT, std::max(max_its, 1)));
+  HS_PETSC(KSPSetInitialGuessNonzero(ksp, guess ? PETSC_TRUE : PETSC_FALSE));
+  HS_PETSC(KSPSolve(ksp, b, x));
   KSPConvergedReason r;
-  HS_PETSC(KSPGetIterationNumber(krylov_, &its));
-  HS_PETSC(KSPGetConvergedReason(krylov_, &r));
+  HS_PETSC(KSPGetIterationNumber(ksp, &its));
+  HS_PETSC(KSPGetConvergedReason(ksp, &r));
   n_.krylov_iterations += its;
+  return r;
+}
+
+bool Tangent::krylov_solve(Vec b, Vec x, bool guess, int max_its, bool& converged) {
+  LogEvent e(events().krylov);
+  PetscInt its;
+  const KSPConvergedReason r = run_krylov(krylov_, b, x, guess, max_its, its);
   since_factor_ += int(its);
   converged = r > 0;
   return usable(r);
@@ -152,16 +157,8 @@ void Tangent::set_up_multigrid() {
 bool Tangent::multigrid_solve(Vec b, Vec x, bool guess) {
   set_up_multigrid();
   LogEvent e(events().krylov);
-  PetscReal bn;
-  HS_PETSC(VecNorm(b, NORM_2, &bn));
-  HS_PETSC(KSPSetTolerances(amg_, 1e-30, forcing_ * bn, PETSC_DEFAULT, 1000));
-  HS_PETSC(KSPSetInitialGuessNonzero(amg_, guess ? PETSC_TRUE : PETSC_FALSE));
-  HS_PETSC(KSPSolve(amg_, b, x));
   PetscInt its;
-  KSPConvergedReason r;
-  HS_PETSC(KSPGetIterationNumber(amg_, &its));
-  HS_PETSC(KSPGetConvergedReason(amg_, &r));
-  n_.krylov_iterations += its;
+  const KSPConvergedReason r = run_krylov(amg_, b, x, guess, 1000, its);
   if (r > 0) return true;
   // CG stops on negative curvature (an indefinite tangent past a limit point) or stagnates:
   // this tangent is factorised instead, so the path goes on as the direct Newton's would.

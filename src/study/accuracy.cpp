@@ -24,19 +24,23 @@ void apply_defaults(AccuracyOptions& a) {
   if (a.ref_h3d < 0) a.ref_h3d = 0.2;
 }
 
+const std::vector<SceneSpec>& accuracy::study_scenes() {
+  static const std::vector<SceneSpec> all{{"disk", "random2d", SceneKind::disk, 0},
+                                          {"r2d-0", "random2d", SceneKind::random2d, 0},
+                                          {"r2d-1", "random2d", SceneKind::random2d, 1},
+                                          {"ood-0", "ood_random2d", SceneKind::random2d, 0},
+                                          {"easy-0", "easy_random2d", SceneKind::random2d, 0},
+                                          {"ball", "random3d", SceneKind::ball, 0},
+                                          {"r3d-0", "random3d", SceneKind::random3d, 0}};
+  return all;
+}
+
 namespace {
 
 std::vector<SceneSpec> scene_specs(const AccuracyOptions& a) {
   if (a.tiny) return {{"disk", "random2d", SceneKind::disk, 0}};
-  const std::vector<SceneSpec> all{{"disk", "random2d", SceneKind::disk, 0},
-                                   {"r2d-0", "random2d", SceneKind::random2d, 0},
-                                   {"r2d-1", "random2d", SceneKind::random2d, 1},
-                                   {"ood-0", "ood_random2d", SceneKind::random2d, 0},
-                                   {"easy-0", "easy_random2d", SceneKind::random2d, 0},
-                                   {"ball", "random3d", SceneKind::ball, 0},
-                                   {"r3d-0", "random3d", SceneKind::random3d, 0}};
   std::vector<SceneSpec> specs;
-  for (const auto& s : all) {
+  for (const auto& s : study_scenes()) {
     const int dim = s.preset == "random3d" ? 3 : 2;
     if (std::find(a.dims.begin(), a.dims.end(), dim) == a.dims.end()) continue;
     if (!a.scenes.empty() && std::find(a.scenes.begin(), a.scenes.end(), s.name) == a.scenes.end()) continue;

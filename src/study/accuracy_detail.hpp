@@ -33,6 +33,10 @@ struct SceneSpec {
   std::int64_t shape_id = 0;
 };
 
+/// The study's scenes: the disk, Random2D shapes 0 and 1, OODRandom2D and EasyRandom2D shape 0,
+/// the ball, Random3D shape 0 (the accuracy study's and the error estimate's validation).
+const std::vector<SceneSpec>& study_scenes();
+
 /// One way of solving the sample problem.
 struct Setting {
   std::string name, group;

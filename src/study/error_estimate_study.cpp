@@ -180,14 +180,7 @@ void run_shape(const config::DatasetConfig& cfg, const factory::ShapeSample& sha
 }  // namespace
 
 void run_estimate_study(const EstimateStudyOptions& o, std::ostream& out) {
-  using accuracy::SceneKind;
-  const std::vector<accuracy::SceneSpec> scenes{{"disk", "random2d", SceneKind::disk, 0},
-                                                {"r2d-0", "random2d", SceneKind::random2d, 0},
-                                                {"r2d-1", "random2d", SceneKind::random2d, 1},
-                                                {"ood-0", "ood_random2d", SceneKind::random2d, 0},
-                                                {"easy-0", "easy_random2d", SceneKind::random2d, 0},
-                                                {"ball", "random3d", SceneKind::ball, 0},
-                                                {"r3d-0", "random3d", SceneKind::random3d, 0}};
+  const std::vector<accuracy::SceneSpec>& scenes = accuracy::study_scenes();
   auto spec = std::find_if(scenes.begin(), scenes.end(), [&](const auto& s) { return s.name == o.scene; });
   if (!o.scene.empty() && spec == scenes.end())
     throw std::invalid_argument("--scene: one of disk r2d-0 r2d-1 ood-0 easy-0 ball r3d-0, got " + o.scene);

@@ -116,6 +116,9 @@ class Tangent {
   /// Multigrid kind: CG + AMG to the forcing term; a factorisation of this tangent where the
   /// Krylov solve fails (an indefinite tangent near a limit point; counted as such).
   bool multigrid_solve(Vec b, Vec x, bool guess);
+  /// One Krylov solve of `ksp` to the forcing term relative to ||b|| (also with a guess),
+  /// its iterations counted; returns PETSc's reason.
+  KSPConvergedReason run_krylov(KSP ksp, Vec b, Vec x, bool guess, int max_its, PetscInt& its);
   static PetscErrorCode apply_shell(PC pc, Vec x, Vec y);
 
   const physics::Problem& problem_;

@@ -41,6 +41,21 @@ class Spring : public Effect {
   std::array<double, 9> tensor(const FacetView& f, int dim) const;
   /// M_ab = int N_a N_b dS_0 over the facet (the facet rule), n_nodes x n_nodes row-major.
   std::array<double, 36> facet_mass(const Space& s, const FacetView& f) const;
+  /// Calls term(face, a, i, b, j, c) for every entry c = M_ab K_ij of every facet's block
+  /// (nodes a, b of the facet, components i, j).
+  template <class Term>
+  void for_each_entry(const Space& s, Term&& term) const {
+    const int dim = s.dim();
+    for (const Face& face : faces_) {
+      const FacetView& f = *face.view;
+      const auto k = tensor(f, dim);
+      const auto m = facet_mass(s, f);
+      for (int a = 0; a < f.n_nodes; ++a)
+        for (int b = 0; b < f.n_nodes; ++b)
+          for (int i = 0; i < dim; ++i)
+            for (int j = 0; j < dim; ++j) term(face, a, i, b, j, m[std::size_t(6 * a + b)] * k[std::size_t(3 * i + j)]);
+    }
+  }
 
   double kn_, kt_;
   FacetPredicate select_;
@@ -90,34 +105,18 @@ void Spring::setup(const Space& s) {
 }
 
 bool Spring::add_energy(const Space& s, const PetscScalar* u, double& energy) const {
-  const int dim = s.dim();
-  for (const Face& face : faces_) {
+  for_each_entry(s, [&](const Face& face, int a, int i, int b, int j, double c) {
     const FacetView& f = *face.view;
-    const auto k = tensor(f, dim);
-    const auto m = facet_mass(s, f);
-    for (int a = 0; a < f.n_nodes; ++a)
-      for (int b = 0; b < f.n_nodes; ++b)
-        for (int i = 0; i < dim; ++i)
-          for (int j = 0; j < dim; ++j)
-            energy += 0.5 * m[std::size_t(6 * a + b)] * k[std::size_t(3 * i + j)] *
-                      PetscRealPart(u[f.offset[std::size_t(a)] + i]) * PetscRealPart(u[f.offset[std::size_t(b)] + j]);
-  }
+    energy += 0.5 * c * PetscRealPart(u[f.offset[std::size_t(a)] + i]) * PetscRealPart(u[f.offset[std::size_t(b)] + j]);
+  });
   return true;
 }
 
 bool Spring::add_residual(const Space& s, const PetscScalar* u, PetscScalar* r) const {
-  const int dim = s.dim();
-  for (const Face& face : faces_) {
+  for_each_entry(s, [&](const Face& face, int a, int i, int b, int j, double c) {
     const FacetView& f = *face.view;
-    const auto k = tensor(f, dim);
-    const auto m = facet_mass(s, f);
-    for (int a = 0; a < f.n_nodes; ++a)
-      for (int b = 0; b < f.n_nodes; ++b)
-        for (int i = 0; i < dim; ++i)
-          for (int j = 0; j < dim; ++j)
-            r[f.offset[std::size_t(a)] + i] +=
-                m[std::size_t(6 * a + b)] * k[std::size_t(3 * i + j)] * u[f.offset[std::size_t(b)] + j];
-  }
+    r[f.offset[std::size_t(a)] + i] += c * u[f.offset[std::size_t(b)] + j];
+  });
   return true;
 }
 
@@ -127,19 +126,19 @@ bool Spring::add_jacobian(const Space& s, const PetscScalar*, Mat J) const {
   const int dim = s.dim(), nd = s.n_cell_dofs();
   CellMatrixAdder adder(s, J);
   std::vector<double> Ke(std::size_t(nd * nd));
-  for (const Face& face : faces_) {
-    const FacetView& f = *face.view;
-    const auto k = tensor(f, dim);
-    const auto m = facet_mass(s, f);
-    std::fill(Ke.begin(), Ke.end(), 0.0);
-    for (int a = 0; a < f.n_nodes; ++a)
-      for (int b = 0; b < f.n_nodes; ++b)
-        for (int i = 0; i < dim; ++i)
-          for (int j = 0; j < dim; ++j)
-            Ke[std::size_t((face.cell_node[std::size_t(a)] * dim + i) * nd + face.cell_node[std::size_t(b)] * dim + j)] +=
-                m[std::size_t(6 * a + b)] * k[std::size_t(3 * i + j)];
-    adder.add(face.cell, Ke.data());
-  }
+  const Face* current = nullptr;
+  auto flush = [&] {
+    if (current) adder.add(current->cell, Ke.data());
+  };
+  for_each_entry(s, [&](const Face& face, int a, int i, int b, int j, double c) {
+    if (&face != current) {
+      flush();
+      current = &face;
+      std::fill(Ke.begin(), Ke.end(), 0.0);
+    }
+    Ke[std::size_t((face.cell_node[std::size_t(a)] * dim + i) * nd + face.cell_node[std::size_t(b)] * dim + j)] += c;
+  });
+  flush();
   return true;
 }
 
