@@ -10,56 +10,28 @@
 ///   hypershape index DIR                        manifest, splits, statistics, XDMF of a dataset
 ///   hypershape effects                          lists the effects a scene may use
 ///
-/// PETSc options (-snes_monitor, -pc_type ..., -log_view) pass through to PETSc.
+/// PETSc options (-snes_monitor, -pc_type ..., -log_view) pass through to PETSc. This file parses
+/// the command line; each subcommand is one call into factory/commands.hpp.
 #include <CLI/CLI.hpp>
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
 #include <cstdlib>
-#include <filesystem>
-#include <iostream>
 
-#include "hypershape/config/dataset.hpp"
-#include "hypershape/config/scene.hpp"
 #include "hypershape/core/error.hpp"
 #include "hypershape/core/log.hpp"
 #include "hypershape/core/petsc_handle.hpp"
-#include "hypershape/core/collective.hpp"
 #include "hypershape/core/interrupt.hpp"
-#include "hypershape/factory/dataset_index.hpp"
-#include "hypershape/factory/generate.hpp"
-#include "hypershape/factory/shape_set.hpp"
-#include "hypershape/factory/solve_scene.hpp"
+#include "hypershape/factory/commands.hpp"
 #include "hypershape/io/dataset_shard.hpp"
-#include "hypershape/io/shape_file.hpp"
-#include "hypershape/mesh/gmsh_mesher.hpp"
 #include "hypershape/physics/registry.hpp"
 #include "hypershape/solver/nonlinear.hpp"
 
 using namespace hypershape;
 
 namespace {
-
-/// Checks that OUT can be created, before any work (nothing is written here).
-void check_output_path(const std::string& out) {
-  namespace fs = std::filesystem;
-  fs::path p(out);
-  if (p.extension() != ".h5") throw core::InputError("", "-o", "output must end in .h5, got '" + out + "'");
-  fs::path dir = p.parent_path().empty() ? fs::path(".") : p.parent_path();
-  std::error_code ec;
-  if (!fs::is_directory(dir, ec)) throw core::InputError("", "-o", "directory does not exist: " + dir.string());
-  if (access(dir.c_str(), W_OK) != 0) throw core::InputError("", "-o", "directory is not writable: " + dir.string());
-}
-
-/// The dataset `generate` makes: a config file, an embedded preset or the default, maybe --mini.
-config::DatasetConfig dataset_to_generate(const std::string& config_path, const std::string& preset, bool mini) {
-  const config::DatasetConfig cfg =
-      !preset.empty()       ? config::preset_dataset(preset)
-      : config_path.empty() ? config::parse_dataset_text(config::default_dataset_text(), "<default dataset>")
-                            : config::parse_dataset_file(config_path);
-  return mini ? config::mini_dataset(cfg) : cfg;
-}
 
 /// The PETSc option names among the arguments CLI11 left (`-name [value]`); anything else is
 /// an input error (a misspelt `--option`, a stray word), named before any work. Any subcommand.
@@ -100,53 +72,6 @@ std::vector<std::string> take_petsc_lookalikes(std::vector<std::string>& args) {
   }
   args = kept;
   return taken;
-}
-
-int run_generate(MPI_Comm comm, const config::DatasetConfig& cfg, const std::string& out,
-                 factory::GenerateOptions gen) {
-  mesh::GmshSession gmsh;
-  gen.output_dir = out.empty() ? "results/" + cfg.name : out;
-  const auto report = factory::generate(comm, cfg, gen);
-  core::info(comm, "[generate] done{}:\n{}", report.indexed ? " (dataset complete: manifest, splits, stats written)"
-                                                             : " (slice written; run `hypershape index` when all are)",
-             factory::report_table(report));
-  return 0;
-}
-
-int run_index(MPI_Comm comm, const std::string& dir) {
-  factory::IndexReport r;
-  core::on_root(comm, [&] { r = factory::index_dataset(dir); });
-  std::string missing;
-  for (auto k : r.missing_shards) missing += (missing.empty() ? "" : ", ") + std::to_string(k);
-  core::info(comm, "{}: {} shards, {} shapes ({} failed), {} load cases converged, {} failed{}", dir, r.shards,
-             r.shapes_ok + r.shapes_failed, r.shapes_failed, r.loads_ok, r.loads_failed,
-             r.complete() ? "; complete" : "; INCOMPLETE, missing shards: " + missing);
-  int complete = r.complete();
-  MPI_Bcast(&complete, 1, MPI_INT, 0, comm);
-  return complete ? 0 : 4;
-}
-
-int run_shapes(MPI_Comm comm, const std::string& config_path, const std::string& out, std::int64_t first,
-               std::int64_t count) {
-  check_output_path(out);
-  mesh::GmshSession gmsh;  // one gmsh session for all shapes of this rank
-  const config::DatasetConfig cfg = config::parse_dataset_file(config_path);
-  if (count < 0) count = cfg.n_shapes - first;
-  if (count < 1 || first + count > cfg.n_shapes)
-    throw core::InputError(config_path, "shapes.count",
-                           fmt::format("--first {} and --count {} must select shapes within [0, {})", first,
-                                       count, cfg.n_shapes));
-  core::info(comm, "{}: drawing shapes {}..{} on {} rank(s)", cfg.name, first, first + count - 1, core::size(comm));
-  const double t0 = core::now_seconds();
-  const auto records = factory::make_shape_range(comm, cfg, first, count);
-  int n_failed = 0;
-  if (core::rank(comm) == 0) {
-    for (const auto& r : records) n_failed += r.numbers.at("failed") != 0;
-    io::write_shapes(out, records, cfg.text, cfg.name, cfg.seed);
-  }
-  MPI_Bcast(&n_failed, 1, MPI_INT, 0, comm);
-  core::info(comm, "{} shapes ({} failed) in {:.1f} s -> {}", count, n_failed, core::now_seconds() - t0, out);
-  return n_failed ? 3 : 0;
 }
 
 struct SolveArgs {
@@ -214,20 +139,6 @@ CLI::App* add_generate(CLI::App& app, GenerateArgs& a) {
   return generate;
 }
 
-int run_solve(MPI_Comm comm, const SolveArgs& a) {
-  // Validate everything that can be validated before any work or output.
-  check_output_path(a.out);
-  config::Scene scene = a.scene.empty()
-                            ? config::parse_scene_text(config::default_scene_text(), "<default scene>")
-                            : config::parse_scene_file(a.scene);
-  auto outcome = factory::solve_scene(comm, scene, a.runs);
-  auto t0 = core::now_seconds();
-  if (core::rank(comm) == 0) io::write_solution(a.out, outcome.record);
-  outcome.times.add("write", core::now_seconds() - t0);
-  core::info(comm, "{} -> {}", factory::summary_line(outcome), a.out);
-  return outcome.converged ? 0 : 3;
-}
-
 int run(int argc, char** argv) {
   MPI_Comm comm = PETSC_COMM_WORLD;
   const int rank = core::rank(comm);
@@ -270,14 +181,15 @@ int run(int argc, char** argv) {
   const std::vector<std::string> petsc_names = petsc_option_names(extras);
   if (*generate) {
     gen.options.petsc_command_line = petsc_names;  // checked by a trial solve before any work
-    return run_generate(comm, dataset_to_generate(gen.config, gen.preset, gen.mini), gen.out, gen.options);
+    return factory::run_generate(comm, factory::dataset_to_generate(gen.config, gen.preset, gen.mini), gen.out,
+                                 gen.options);
   }
   if (*index) {
     core::install_interrupt_handlers("index", rank);  // a manifest being replaced is removed
-    return run_index(comm, index_dir);
+    return factory::run_index(comm, index_dir);
   }
-  if (*shapes) return run_shapes(comm, shapes_args.config, shapes_args.out, shapes_args.first, shapes_args.count);
-  return run_solve(comm, solve_args);  // the one subcommand left
+  if (*shapes) return factory::run_shapes(comm, shapes_args.config, shapes_args.out, shapes_args.first, shapes_args.count);
+  return factory::run_solve(comm, solve_args.scene, solve_args.out, solve_args.runs);  // the one subcommand left
 }
 
 /// What `-help` (PETSc's) prints first: the project's own settings are YAML keys, not PETSc
