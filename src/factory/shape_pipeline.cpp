@@ -26,37 +26,6 @@ struct Rejection {
   std::string stage, reason;
 };
 
-/// Scales a boundary into [-1, 1]^d (centred bounding box, largest half-extent 1).
-void normalise_into_box(geometry::Boundary& b) {
-  const int d = b.dim;
-  double lo[3], hi[3];
-  for (int a = 0; a < d; ++a) lo[a] = std::numeric_limits<double>::infinity(), hi[a] = -lo[a];
-  for (std::size_t i = 0; i < b.points.size(); i += d)
-    for (int a = 0; a < d; ++a) lo[a] = std::min(lo[a], b.points[i + a]), hi[a] = std::max(hi[a], b.points[i + a]);
-  double half = 0.0;
-  for (int a = 0; a < d; ++a) half = std::max(half, 0.5 * (hi[a] - lo[a]));
-  for (std::size_t i = 0; i < b.points.size(); i += d)
-    for (int a = 0; a < d; ++a) b.points[i + a] = (b.points[i + a] - 0.5 * (lo[a] + hi[a])) / half;
-}
-
-/// Per boundary point: the mean length of its facets' edges through it (the resolved size).
-std::vector<double> boundary_spacing(const geometry::Boundary& b) {
-  std::vector<double> sum(std::size_t(b.n_points()), 0.0), count(sum.size(), 0.0);
-  const int d = b.dim;
-  for (std::int64_t f = 0; f < b.n_facets(); ++f) {
-    const auto v = b.facet(f);
-    for (int e = 0; e < d; ++e) {
-      const int i = v[e], j = v[(e + 1) % d];
-      if (d == 2 && e == 1) break;  // a segment has one edge
-      double l2 = 0.0;
-      for (int a = 0; a < d; ++a) l2 += std::pow(b.point(i)[a] - b.point(j)[a], 2);
-      const double l = std::sqrt(l2);
-      sum[i] += l, sum[j] += l, count[i] += 1, count[j] += 1;
-    }
-  }
-  for (std::size_t i = 0; i < sum.size(); ++i) sum[i] = count[i] > 0 ? sum[i] / count[i] : 0.0;
-  return sum;
-}
 
 std::vector<double> base_sample(const ShapeConfig& c, const std::optional<geometry::Boundary>& base) {
   if (c.dim == 2) return geometry::unit_circle(2048).points;
@@ -197,7 +166,7 @@ geometry::Boundary draw_boundary(const ShapeConfig& c, const std::optional<geome
 /// A surface file normalised into [-1, 1]^3. Throws core::InputError.
 geometry::Boundary load_surface(const std::string& path) {
   geometry::Boundary b = mesh::read_surface_file(path);
-  normalise_into_box(b);
+  geometry::normalise_into_box(b);
   return b;
 }
 
@@ -269,7 +238,7 @@ ShapeSample make_shape(const ShapeConfig& config, const std::optional<geometry::
       const double t1 = core::now_seconds();
       mesh::BoundaryMeshOptions mopt;
       mopt.h = std::max(config.h, config.mesh_h);
-      mopt.point_sizes = boundary_spacing(out.boundary);
+      mopt.point_sizes = geometry::boundary_spacing(out.boundary);
       try {
         out.mesh = mesh::mesh_boundary(out.boundary, mopt);
       } catch (const std::runtime_error& e) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace hypershape::geometry {
@@ -57,6 +58,36 @@ std::array<double, 3> uniform_boundary_point(const Boundary& b, core::RandomStre
       x[a] = (1 - s - t) * b.point(v[0])[a] + s * b.point(v[1])[a] + t * b.point(v[2])[a];
   }
   return x;
+}
+
+void normalise_into_box(Boundary& b) {
+  const int d = b.dim;
+  double lo[3], hi[3];
+  for (int a = 0; a < d; ++a) lo[a] = std::numeric_limits<double>::infinity(), hi[a] = -lo[a];
+  for (std::size_t i = 0; i < b.points.size(); i += d)
+    for (int a = 0; a < d; ++a) lo[a] = std::min(lo[a], b.points[i + a]), hi[a] = std::max(hi[a], b.points[i + a]);
+  double half = 0.0;
+  for (int a = 0; a < d; ++a) half = std::max(half, 0.5 * (hi[a] - lo[a]));
+  for (std::size_t i = 0; i < b.points.size(); i += d)
+    for (int a = 0; a < d; ++a) b.points[i + a] = (b.points[i + a] - 0.5 * (lo[a] + hi[a])) / half;
+}
+
+std::vector<double> boundary_spacing(const Boundary& b) {
+  std::vector<double> sum(std::size_t(b.n_points()), 0.0), count(sum.size(), 0.0);
+  const int d = b.dim;
+  for (std::int64_t f = 0; f < b.n_facets(); ++f) {
+    const auto v = b.facet(f);
+    for (int e = 0; e < d; ++e) {
+      const int i = v[e], j = v[(e + 1) % d];
+      if (d == 2 && e == 1) break;  // a segment has one edge
+      double l2 = 0.0;
+      for (int a = 0; a < d; ++a) l2 += std::pow(b.point(i)[a] - b.point(j)[a], 2);
+      const double l = std::sqrt(l2);
+      sum[i] += l, sum[j] += l, count[i] += 1, count[j] += 1;
+    }
+  }
+  for (std::size_t i = 0; i < sum.size(); ++i) sum[i] = count[i] > 0 ? sum[i] / count[i] : 0.0;
+  return sum;
 }
 
 }  // namespace hypershape::geometry

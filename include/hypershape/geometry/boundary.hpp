@@ -44,4 +44,10 @@ double facet_measure(const Boundary& b, std::int64_t f);
 std::array<double, 3> uniform_boundary_point(const Boundary& b, core::RandomStream& rng,
                                              std::span<const std::uint8_t> excluded = {});
 
+/// Scales `b` into [-1, 1]^d: its bounding box centred at the origin, the largest half-extent 1.
+void normalise_into_box(Boundary& b);
+
+/// Per boundary point: the mean length of the facet edges through it (the size it is resolved at).
+std::vector<double> boundary_spacing(const Boundary& b);
+
 }  // namespace hypershape::geometry
