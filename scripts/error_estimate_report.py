@@ -2,7 +2,7 @@
 """The effectivity of the labels' error estimate (docs/ACCURACY.md, issue 19) from the JSON
 lines of study_error_estimate (scripts/error_estimate_study.sh):
 
-  error_estimate_report.py results/error_estimate/*.jsonl [--plot docs/figures/error_estimate.png]
+  error_estimate_report.py docs/error_estimate/*.jsonl [--plot docs/figures/error_estimate.png]
 
 prints a markdown table per case family (label: scene or preset, degree, h) and over all:
 effectivity index estimate / true of the relative L2 error of u (and |max|u|| and |alpha|

@@ -3,13 +3,13 @@
 # error"): build/study_error_estimate on the accuracy study's scenes and on random Random2D /
 # Random3D load cases, then scripts/error_estimate_report.py (table + log-log plot).
 #   scripts/error_estimate_study.sh [PART...]    parts: random2d scenes2d p2 random3d scenes3d report
-#                                                (default: all; each appends to results/error_estimate/PART.jsonl)
+#                                                (default: all; each appends to docs/error_estimate/PART.jsonl)
 # One rank, OPENBLAS_NUM_THREADS=1; references with MUMPS (-ref_ prefix). Runtime on the shared
 # 2-core VM: random2d ~10 min, scenes2d ~5, p2 ~10, random3d/scenes3d ~10 each.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BIN=${BIN:-build/study_error_estimate}
-OUT=${OUT:-results/error_estimate}
+OUT=${OUT:-docs/error_estimate}
 mkdir -p "$OUT" docs/figures
 export OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
 ref=(-ref_pc_factor_mat_solver_type mumps)
