@@ -27,25 +27,6 @@ std::vector<physics::EffectPtr> ball_effects() {
   return e;
 }
 
-/// Ascending eigenvalues of a (small) symmetric matrix, densely.
-std::vector<double> dense_eigenvalues(Mat K) {
-  Mat D;
-  HS_PETSC(MatConvert(K, MATDENSE, MAT_INITIAL_MATRIX, &D));
-  PetscInt n;
-  HS_PETSC(MatGetSize(D, &n, nullptr));
-  std::vector<PetscScalar> a(static_cast<std::size_t>(n * n)), w(static_cast<std::size_t>(n)), work(static_cast<std::size_t>(8 * n));
-  {
-    const PetscScalar* d;
-    HS_PETSC(MatDenseGetArrayRead(D, &d));
-    std::copy(d, d + n * n, a.begin());
-    HS_PETSC(MatDenseRestoreArrayRead(D, &d));
-  }
-  HS_PETSC(MatDestroy(&D));
-  PetscBLASInt bn = PetscBLASInt(n), lwork = PetscBLASInt(work.size()), info;
-  LAPACKsyev_("N", "U", &bn, a.data(), &bn, w.data(), work.data(), &lwork, &info);
-  REQUIRE(info == 0);
-  return w;
-}
 
 }  // namespace
 

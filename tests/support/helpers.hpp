@@ -3,11 +3,14 @@
 /// vectors with the (homogeneous) essential values, quadrature L2 errors, facet predicates and
 /// the seed paper's disk scene.
 #include <petscdmplex.h>
+// after a PETSc header: petscblaslapack.h uses PETSC_COMM_SELF without including petscsys.h
+#include <petscblaslapack.h>
 
 #include <cmath>
 #include <cstring>
 #include <functional>
 #include <random>
+#include <stdexcept>
 #include <vector>
 
 #include "hypershape/core/error.hpp"
@@ -178,6 +181,27 @@ inline hs::physics::SpaceOptions degree(int p) {
   hs::physics::SpaceOptions o;
   o.degree = p;
   return o;
+}
+
+/// Ascending eigenvalues of a (small) symmetric matrix, densely (LAPACK syev). Not collective.
+inline std::vector<PetscScalar> dense_eigenvalues(Mat K) {
+  Mat D;
+  HS_PETSC(MatConvert(K, MATDENSE, MAT_INITIAL_MATRIX, &D));
+  PetscInt n;
+  HS_PETSC(MatGetSize(D, &n, nullptr));
+  std::vector<PetscScalar> a(static_cast<std::size_t>(n * n)), w(static_cast<std::size_t>(n)),
+      work(static_cast<std::size_t>(8 * n));
+  {
+    const PetscScalar* d;
+    HS_PETSC(MatDenseGetArrayRead(D, &d));
+    std::copy(d, d + n * n, a.begin());
+    HS_PETSC(MatDenseRestoreArrayRead(D, &d));
+  }
+  HS_PETSC(MatDestroy(&D));
+  PetscBLASInt bn = PetscBLASInt(n), lwork = PetscBLASInt(work.size()), info;
+  LAPACKsyev_("N", "U", &bn, a.data(), &bn, w.data(), work.data(), &lwork, &info);
+  if (info != 0) throw std::runtime_error("dense_eigenvalues: LAPACK syev failed");
+  return w;
 }
 
 }  // namespace hstest
