@@ -73,7 +73,7 @@ TEST_CASE("LOBPCG preconditioned by GAMG settles the sign of the tangent's small
   core::VecH u = p.create_vector();
   core::MatH K = p.create_matrix();
   REQUIRE(p.jacobian(u, K));
-  const auto w = dense_eigenvalues(K);
+  const auto w = hstest::dense_eigenvalues(K);
   REQUIRE(w[0] > 0);
   solver::set_rigid_body_near_null_space(p, K);
   for (double sigma : {0.5 * w[0], 0.5 * (w[0] + w[1]), 0.5 * (w[2] + w[3])}) {
