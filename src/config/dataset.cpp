@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "hypershape/mesh/surface_file.hpp"
+#include "hypershape/physics/region.hpp"
 #include "effects_block.hpp"
 #include "solver_block.hpp"
 #include "yaml_block.hpp"
@@ -243,23 +244,55 @@ physics::EffectPtr make_one(const DatasetConfig& c, std::size_t i) {
   return physics::build_effect(resolved[i], c.shapes.dim);
 }
 
+/// A dataset's `dirichlet` effects: fixed regions (no draws), every component fixed (the stored
+/// dirichlet_mask means u = 0); each becomes a facet selector of the shape family, so that its
+/// facets join the shape's Dirichlet facets (mask, distance, load placements).
+void check_fixed_supports(DatasetConfig& c) {
+  const auto& spec = c.scene;
+  c.shapes.fixed_supports.clear();
+  for (auto i : spec.find("dirichlet")) {
+    const auto& e = spec.effects[i];
+    if (e.params.count("components"))
+      throw InputError(c.source, e.path + ".components",
+                       "a dataset's Dirichlet regions fix every component (the stored dirichlet_mask means u = 0); "
+                       "sliding supports are for scenes");
+    for (const auto& [key, value] : e.params)
+      if (std::holds_alternative<physics::Draw>(value))
+        throw InputError(c.source, e.path + "." + key, "a fixed region: give numbers (a drawn support is the "
+                                                       "dirichlet_patch)");
+    physics::EffectParams p(c.source, e.path);
+    for (const auto& [key, value] : e.params) {
+      if (const auto* d = std::get_if<double>(&value)) p.set(key, *d);
+      else if (const auto* v = std::get_if<std::vector<double>>(&value)) p.set(key, *v);
+      else p.set(key, std::get<std::string>(value));
+    }
+    c.shapes.fixed_supports.push_back(physics::Region::from_params(p, c.shapes.dim, true).facets());
+  }
+}
+
 /// Rejects, before any work, a dataset scene the factory cannot run: unknown effects or keys,
 /// values out of range at either end of a distribution, draws per load case of what is set up
-/// once per shape, no or two materials, no dirichlet_patch or a second support, no load scaled by alpha.
+/// once per shape, no or two materials, two dirichlet_patch or no Dirichlet support, a drawn or
+/// sliding dirichlet region, no load scaled by alpha.
 void check_dataset_scene(DatasetConfig& c) {
   const auto& spec = c.scene;
   const int dim = c.shapes.dim;
   const auto patches = spec.find("dirichlet_patch");
-  if (patches.size() != 1)
-    throw InputError(c.source, "effects", "a dataset needs exactly one dirichlet_patch (its centre is drawn "
-                                          "on each shape's boundary, and the mesh conforms to it)");
-  const auto& patch = spec.effects[patches[0]];
-  for (auto i : spec.find("dirichlet"))  // (issue 18: several supports per dataset are not done)
-    throw InputError(c.source, spec.effects[i].path,
-                     "a dataset's Dirichlet support is its one dirichlet_patch: the stored dirichlet_mask and "
-                     "dirichlet_distance would not cover this region (use a spring, or a scene)");
-  if (patch.params.count("center"))
-    throw InputError(c.source, patch.path + ".center", "drawn on each shape's boundary by the factory: leave it out");
+  if (patches.size() > 1)
+    throw InputError(c.source, spec.effects[patches[1]].path,
+                     "a dataset has at most one dirichlet_patch (its centre is drawn on each shape's boundary "
+                     "and the mesh conforms to its ends); add fixed regions as dirichlet: [{box: [lower corner, "
+                     "upper corner]}, {center: [...], radius: r}, ...]");
+  check_fixed_supports(c);
+  if (patches.empty() && spec.find("dirichlet").empty())
+    throw InputError(c.source, "effects", "a dataset needs a Dirichlet support: a dirichlet_patch (drawn on each "
+                                          "shape) and/or dirichlet regions (fixed: box or center + radius)");
+  if (patches.empty()) {
+    c.shapes.dirichlet_radius = 0.0;  // no drawn patch: only the fixed regions
+  } else if (spec.effects[patches[0]].params.count("center")) {
+    throw InputError(c.source, spec.effects[patches[0]].path + ".center",
+                     "drawn on each shape's boundary by the factory: leave it out");
+  }
   std::vector<physics::EffectPtr> built;
   for (int corner = 0; corner < 2; ++corner) {
     if (corner == 0)  // before the checks of the whole: copies of a material are two materials
@@ -283,13 +316,16 @@ void check_dataset_scene(DatasetConfig& c) {
         throw InputError(c.source, e.path + "." + key, "a vector: give it fixed, or leave it out to draw it");
     }
   }
-  const auto r = patch.params.find("radius");
-  if (r != patch.params.end()) {
-    if (const auto* d = std::get_if<physics::Draw>(&r->second)) c.shapes.dirichlet_radius = d->high();
-    else if (const auto* v = std::get_if<double>(&r->second)) c.shapes.dirichlet_radius = *v;
+  if (!patches.empty()) {
+    const auto& patch = spec.effects[patches[0]];
+    const auto r = patch.params.find("radius");
+    if (r != patch.params.end()) {
+      if (const auto* d = std::get_if<physics::Draw>(&r->second)) c.shapes.dirichlet_radius = d->high();
+      else if (const auto* v = std::get_if<double>(&r->second)) c.shapes.dirichlet_radius = *v;
+    }
+    if (!(c.shapes.dirichlet_radius > 0 && c.shapes.dirichlet_radius <= 2.0))
+      throw InputError(c.source, patch.path + ".radius", "must be in (0, 2]");
   }
-  if (!(c.shapes.dirichlet_radius > 0 && c.shapes.dirichlet_radius <= 2.0))
-    throw InputError(c.source, patch.path + ".radius", "must be in (0, 2]");
   for (auto i : spec.find("neo_hookean"))
     for (auto [key, out] : {std::pair{"E", &c.material.E}, std::pair{"nu", &c.material.nu}})
       if (auto it = spec.effects[i].params.find(key); it != spec.effects[i].params.end())

@@ -163,6 +163,33 @@ geometry::Boundary draw_boundary(const ShapeConfig& c, const std::optional<geome
   return c.dim == 2 ? draw_curve(c, phi, patch_rng, out) : draw_surface(c, base, phi, patch_rng, out);
 }
 
+/// The Dirichlet facets of an accepted draw: those in the patch and in every fixed region
+/// (sorted, each once); throws Rejection if a fixed region holds no facet of the boundary.
+std::vector<int> dirichlet_facets(const ShapeConfig& c, const ShapeSample& s) {
+  std::vector<int> out;
+  if (c.dirichlet_radius > 0) {
+    std::array<double, 3> p = s.dirichlet_center;
+    if (c.dim == 2) p[2] = 0.0;
+    out = geometry::facets_in_ball(s.boundary, p, c.dirichlet_radius);
+  }
+  if (c.fixed_supports.empty()) return out;  // the paper's patch alone: its facets as they were
+  const geometry::Boundary& b = s.boundary;
+  for (std::size_t k = 0; k < c.fixed_supports.size(); ++k) {
+    std::size_t n_in = 0;
+    for (std::int64_t f = 0; f < b.n_facets(); ++f) {
+      const auto v = b.facet(f);
+      double x[9];
+      for (int a = 0; a < c.dim; ++a)
+        for (int i = 0; i < c.dim; ++i) x[a * c.dim + i] = b.point(v[std::size_t(a)])[i];
+      if (c.fixed_supports[k](x, c.dim, c.dim)) out.push_back(int(f)), ++n_in;
+    }
+    if (n_in == 0) throw Rejection{"support", fmt::format("fixed Dirichlet region {} holds no boundary facet", k)};
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
 /// A surface file normalised into [-1, 1]^3. Throws core::InputError.
 geometry::Boundary load_surface(const std::string& path) {
   geometry::Boundary b = mesh::read_surface_file(path);
@@ -249,11 +276,7 @@ ShapeSample make_shape(const ShapeConfig& config, const std::optional<geometry::
       const double t2 = core::now_seconds();
       out.attempt = attempt;
       out.dirichlet_radius = config.dirichlet_radius;
-      if (config.dirichlet_radius > 0) {
-        std::array<double, 3> c = out.dirichlet_center;
-        if (config.dim == 2) c[2] = 0.0;
-        out.dirichlet_facets = geometry::facets_in_ball(out.boundary, c, config.dirichlet_radius);
-      }
+      out.dirichlet_facets = dirichlet_facets(config, out);
       const geometry::Boundary ref = reference_base(config, base);
       // Hausdorff accuracy (3D only): h / 8, i.e. 1.25% of the box half-width at h = 0.1.
       out.metrics = geometry::compute_metrics(out.boundary, &ref, config.h / (config.dim == 2 ? 20 : 8));

@@ -166,11 +166,14 @@ void Problem::jacobian_pointwise(Vec u, Mat J) const {
 
 Resultants Problem::resultants(Vec u, double load_factor) const {
   const int dim = space_->dim();
-  LocalArray ul(dm(), false), fi(dm(), true), fe(dm(), true), ff(dm(), true);
+  LocalArray ul(dm(), false), fi(dm(), true), fs(dm(), true), fe(dm(), true), ff(dm(), true);
   to_local(u, ul.vec());
   bool ok = true;
   for (auto& eff : effects_) {
-    if (eff->has_energy()) ok = ok && eff->add_residual(*space_, ul.array(), fi.array());
+    // An elastic support's force (a spring) does not sum to zero like the material's: it is an
+    // external force on the body, kept apart so that the balance closes (spring_force).
+    if (eff->has_energy())
+      ok = ok && eff->add_residual(*space_, ul.array(), eff->is_material() ? fi.array() : fs.array());
     if (eff->has_load() && eff->active()) eff->add_load(*space_, eff->scaled() ? fe.array() : ff.array());
   }
   Resultants out;
@@ -184,7 +187,8 @@ Resultants Problem::resultants(Vec u, double load_factor) const {
   HS_PETSC(DMGetCoordinateSection(dm(), &cs));
   HS_PETSC(DMGetCoordinatesLocal(dm(), &coords));
   const core::VecArray<const PetscScalar> xa(coords);
-  const PetscScalar *a = ul.array(), *f_int = fi.array(), *f_ext = fe.array(), *f_fix = ff.array();
+  const PetscScalar *a = ul.array(), *f_int = fi.array(), *f_spring = fs.array(), *f_ext = fe.array(),
+                    *f_fix = ff.array();
   PetscInt p0, p1;
   HS_PETSC(PetscSectionGetChart(ls, &p0, &p1));
   for (PetscInt p = p0; p < p1; ++p) {
@@ -194,26 +198,29 @@ Resultants Problem::resultants(Vec u, double load_factor) const {
     HS_PETSC(PetscSectionGetOffset(ls, p, &off));
     HS_PETSC(PetscSectionGetConstraintDof(ls, p, &n_con));
     const std::array<double, 3> x = Space::node_coords(dm(), cs, xa.data(), p, dim);
-    double y[3] = {0, 0, 0}, load[3] = {0, 0, 0}, support[3] = {0, 0, 0};
+    double y[3] = {0, 0, 0}, load[3] = {0, 0, 0}, support[3] = {0, 0, 0}, spring[3] = {0, 0, 0};
     for (int i = 0; i < dim; ++i) {
       y[i] = x[i] + PetscRealPart(a[off + i]);
       load[i] = load_factor * PetscRealPart(f_ext[off + i]) + PetscRealPart(f_fix[off + i]);
+      spring[i] = -PetscRealPart(f_spring[off + i]);  // the spring pulls back: -K u
       out.applied_force[i] += load[i];
+      out.spring_force[i] += spring[i];
     }
     add_moment(y, load, out.applied_moment);
     add_moment(x.data(), load, out.applied_moment_reference);
+    add_moment(y, spring, out.spring_moment);
     if (n_con == 0) continue;
     const PetscInt* con;
     HS_PETSC(PetscSectionGetConstraintIndices(ls, p, &con));
     for (PetscInt k = 0; k < n_con; ++k) {
       const PetscInt i = con[k];
-      support[i] = PetscRealPart(f_int[off + i]) - load[i];
+      support[i] = PetscRealPart(f_int[off + i]) - spring[i] - load[i];
       out.reaction_force[i] += support[i];
     }
     add_moment(y, support, out.reaction_moment);
   }
-  for (auto* v : {&out.reaction_force, &out.reaction_moment, &out.applied_force,
-                  &out.applied_moment, &out.applied_moment_reference})
+  for (auto* v : {&out.reaction_force, &out.reaction_moment, &out.applied_force, &out.applied_moment,
+                  &out.applied_moment_reference, &out.spring_force, &out.spring_moment})
     MPI_Allreduce(MPI_IN_PLACE, v->data(), 3, MPI_DOUBLE, MPI_SUM, comm());
   return out;
 }

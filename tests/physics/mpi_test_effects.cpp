@@ -61,6 +61,12 @@ TEST_CASE("Catalogue effects have the same solution on any number of ranks", "[m
          e.push_back(physics::make_spring(50.0, 20.0, physics::Region::box({-1, -1}, {0, 1})));
          return e;
        }},
+      {"two Dirichlet supports: the patch and a clamped region (issue 18)",
+       [] {
+         auto e = scene(physics::make_neo_hookean(500, 0.4), traction());
+         e.push_back(physics::make_dirichlet("region", physics::Region::ball({0, -1}, 0.4).facets()));
+         return e;
+       }},
       {"neo_hookean with inclusions (issue 18)",
        [inc = physics::InclusionField(2, 4, 0.3, 5.0, 3)] {
          return scene(physics::make_neo_hookean(500, 0.4, [inc](const double* x) { return inc(x); }), traction());

@@ -32,7 +32,8 @@
 ///                                 # shorthands of this scene (the paper's three effects):
 /// effects:                        # optional, instead of the shorthands: a scene's effects
 ///   neo_hookean: {E: {uniform: [400, 600], sample: shape}, nu: 0.49}
-///   dirichlet_patch: {radius: 0.5}          # centre drawn on each shape's boundary
+///   dirichlet_patch: {radius: 0.5}          # centre drawn on each shape's boundary (at most one)
+///   dirichlet: [{box: [-3, -3, -0.7, 3]}]   # optional fixed regions (box or center + radius)
 ///   gaussian_traction:                      # a list: several tractions per load case, each
 ///     - {gamma: 0.2}                        # centre and direction drawn per load case
 ///     - {gamma: {choice: [0.1, 0.2], sample: load}}

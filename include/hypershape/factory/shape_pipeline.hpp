@@ -6,6 +6,7 @@
 /// the same shape for the same (seed, shape id).
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -46,6 +47,12 @@ struct ShapeConfig {
   /// per unit distance (geometry::RemeshOptions::size): the rim is where the error lives.
   double rim_size = 0.0;
   double dirichlet_radius = 0.5;         ///< r of the Dirichlet patch; 0: no patch
+  /// Fixed Dirichlet regions besides the drawn patch (a dataset's `dirichlet` effects): each
+  /// selects boundary facets by their vertex coordinates (n_vertices x dim, row-major), as the
+  /// effect marks them on the mesh. Their facets join dirichlet_facets (so the stored mask and
+  /// distance and the load placements see them); a draw with no facet in some region is
+  /// redrawn (stage "support"): the family is conditioned on reaching every region.
+  std::vector<std::function<bool(const double* vertex_coords, int n_vertices, int dim)>> fixed_supports;
   double max_turn_deg = 15.0;            ///< 2D: largest turning angle per boundary edge
   double min_feature_fraction = 0.1;     ///< redraw if a feature is thinner than this * h
   double size_grading = 0.3;             ///< growth of the boundary size per unit length
@@ -63,7 +70,7 @@ geometry::Boundary solve_surface(const geometry::Boundary& drawn, const ShapeCon
 /// A rejected draw: which attempt, at which stage, and why.
 struct RejectedDraw {
   int attempt = 0;
-  std::string stage;   ///< boundary | feature | mesh | quality
+  std::string stage;   ///< boundary | feature | mesh | quality | support
   std::string reason;
 };
 
@@ -75,7 +82,7 @@ struct ShapeSample {
   mesh::MeshData mesh;
   std::array<double, 3> dirichlet_center{};  ///< p_D (on the boundary)
   double dirichlet_radius = 0.0;
-  std::vector<int> dirichlet_facets;        ///< boundary facets inside the patch
+  std::vector<int> dirichlet_facets;        ///< boundary facets inside the patch or a fixed region
   geometry::ShapeMetrics metrics;
   mesh::MeshQuality quality;
   std::vector<RejectedDraw> rejected;

@@ -31,9 +31,12 @@ struct NodalField {
 /// s sum_a (x_a + u_a) x f_ext_a = s int (x + u) x t dS_0: dead loads act where the material
 /// point is now. With every dof, sum_a f_int_a = 0 and sum_a (x_a + u_a) x f_int_a = 0 hold
 /// exactly for any u (translation invariance; frame indifference, tau = P F^T symmetric, and
-/// x + u_h lies in the discrete space), so
-///   reaction_force + applied_force = -sum_free r_k,
-///   reaction_moment + applied_moment = -sum_free (x + u)_k x r_k,
+/// x + u_h lies in the discrete space). An elastic support (a spring: an energy that is not the
+/// material's) is an external force -K u on the body: spring_force = -sum_a (K u)_a over every
+/// dof (constrained ones too; the support force at a constrained dof is what is left after it).
+/// So
+///   reaction_force + spring_force + applied_force = -sum_free r_k,
+///   reaction_moment + spring_moment + applied_moment = -sum_free (x + u)_k x r_k,
 /// with r the free-dof residual: both vanish at equilibrium. The moment in the reference
 /// positions, s int x x t dS_0, differs by s int u x t dS_0 and does not balance.
 struct Resultants {
@@ -43,6 +46,8 @@ struct Resultants {
   std::array<double, 3> applied_force{};    ///< s int t dS_0 (+ the fixed loads)
   std::array<double, 3> applied_moment{};   ///< s int (x + u) x t dS_0 (deformed positions)
   std::array<double, 3> applied_moment_reference{};  ///< s int x x t dS_0 (reference positions)
+  std::array<double, 3> spring_force{};     ///< exerted on the body by elastic supports (springs)
+  std::array<double, 3> spring_moment{};    ///< sum over dofs of (x + u) x spring force
 };
 
 class Problem {
@@ -77,8 +82,9 @@ class Problem {
   void residual_pointwise(Vec u, Vec r) const;
   void jacobian_pointwise(Vec u, Mat J) const;
 
-  /// Reaction of the essential conditions and resultant of the load s f_ext at the state u
-  /// (global vector), reduced over the communicator: every rank gets the totals. Collective.
+  /// Reaction of the essential conditions, force of the elastic supports and resultant of the
+  /// load s f_ext at the state u (global vector), reduced over the communicator: every rank gets
+  /// the totals. Collective.
   Resultants resultants(Vec u, double load_factor) const;
 
   /// max over nodes of |u| (collective).
