@@ -170,7 +170,7 @@ bad surface base_cut_stl  2 "cut.stl"                     "$(surf "$work/cut.stl
 
 # ---- effects ----------------------------------------------------------------------------------
 bad effects scalar_effects 2 "effects: must be a mapping" "$(add 'effects: 5')"
-bad effects no_patch      2 "effects: a dataset needs exactly one dirichlet_patch" "$(add $'effects:\n  neo_hookean: {E: 500}\n  gaussian_traction: {gamma: 0.2}')"
+bad effects no_patch      2 "effects: a dataset needs a Dirichlet support" "$(add $'effects:\n  neo_hookean: {E: 500}\n  gaussian_traction: {gamma: 0.2}')"
 
 # ---- resources: a full disk (a small tmpfs) -----------------------------------------------------
 fsdir="$work/fs"
