@@ -117,3 +117,23 @@ TEST_CASE("Bad Dirichlet supports in a dataset are refused naming the key", "[fa
   CHECK_THAT(message("  dirichlet: {components: [0]}\n"), Catch::Contains("dirichlet"));
   CHECK_THAT(message("  spring: {stiffness: 10}\n"), Catch::Contains("needs a Dirichlet support"));
 }
+
+TEST_CASE("In 3D a fixed region's facets join the drawn patch's", "[factory][supports]") {
+  auto parse3 = [](const std::string& extra) {
+    return config::parse_dataset_text("preset: random3d\nseed: 3\nshapes: {count: 1, h: 0.2}\neffects:\n"
+                                      "  neo_hookean: {E: 500, nu: 0.49}\n  dirichlet_patch: {radius: 0.4}\n" +
+                                          extra + "  gaussian_traction: {gamma: 0.2}\n",
+                                      "<test>");
+  };
+  const auto c = parse3("  dirichlet: {box: [-3, -3, -3, 3, 3, -0.7]}\n"), plain = parse3("");
+  const auto s = factory::make_shape(factory::shape_config(c, 0), std::nullopt, c.seed, 0);
+  const auto p = factory::make_shape(factory::shape_config(plain, 0), std::nullopt, plain.seed, 0);
+  REQUIRE(p.attempt == s.attempt);  // measured: the region is reached at the first attempt
+  REQUIRE(p.boundary.points == s.boundary.points);
+  std::set<int> want(p.dirichlet_facets.begin(), p.dirichlet_facets.end());
+  int n_region = 0;
+  for (int f = 0; f < int(s.boundary.n_facets()); ++f)
+    if (facet_in(s.boundary, f, [](const double* x) { return x[2] <= -0.7 + 1e-9; })) want.insert(f), ++n_region;
+  CHECK(n_region > 0);
+  CHECK(std::vector<int>(want.begin(), want.end()) == s.dirichlet_facets);
+}
