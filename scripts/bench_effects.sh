@@ -11,7 +11,7 @@
 #   spring         + spring {stiffness: 10} on the whole free boundary
 #   inclusions     Neo-Hookean with 3 inclusions (radius 0.25, 5x stiffer; a modulus channel)
 #   grf            Neo-Hookean with a log-normal GRF modulus (cv 0.3, correlation length 0.3)
-#   supports3      + two fixed dirichlet regions (x <= -0.7; a ball of radius 0.8 at (0, -1.5))
+#   supports3      + two fixed dirichlet regions (clamps2d's: x <= -0.85; a ball of radius 0.5 at (0, -1.4))
 #   pressure       + a fixed dead pressure 2 on the whole boundary
 #   mooney_rivlin  Mooney-Rivlin (C1 60, C2 24, kappa 8333: mu, K of E 500, nu 0.49) instead
 #   linear_elastic linear elasticity instead (one linear solve per load case: alpha exact)
@@ -53,7 +53,7 @@ variant spring "$nh" "$patch" "$traction" "  spring: {stiffness: 10}"
 variant inclusions "  neo_hookean: {E: 500, nu: 0.49, inclusions: 3, inclusion_radius: 0.25, inclusion_ratio: 5}" \
   "$patch" "$traction"
 variant grf "  neo_hookean: {E: 500, nu: 0.49, E_cv: 0.3, E_length: 0.3}" "$patch" "$traction"
-variant supports3 "$nh" "$patch" "  dirichlet: [{box: [-3, -3, -0.7, 3]}, {center: [0, -1.5], radius: 0.8}]" "$traction"
+variant supports3 "$nh" "$patch" "  dirichlet: [{box: [-3, -3, -0.85, 3]}, {center: [0, -1.4], radius: 0.5}]" "$traction"
 variant pressure "$nh" "$patch" "$traction" "  pressure: {value: 2, scale: fixed}"
 variant mooney_rivlin "  mooney_rivlin: {C1: 60, C2: 24, kappa: 8333}" "$patch" "$traction"
 variant linear_elastic "  linear_elastic: {E: 500, nu: 0.49}" "$patch" "$traction"
