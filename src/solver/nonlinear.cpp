@@ -296,7 +296,7 @@ LinearCounters NonlinearSolver::linear_counters() const {
 }
 
 bool NonlinearSolver::apply_tangent_factor(Vec x, Vec y) {
-  return !tangent_->multigrid() && tangent_->apply_factor(x, y);
+  return !tangent_->multigrid() && tangent_->has_factor() && tangent_->apply_factor(x, y);
 }
 
 bool NonlinearSolver::rest_response() {

@@ -145,7 +145,7 @@ class NonlinearSolver {
 
   /// y = F^-1 x with the tangent factor the last solve left in use (of the tangent at, or one
   /// Newton step before, its final state). False where none exists (the multigrid linear
-  /// solver) or the solve fails. The labels' error estimate uses it as its coarse solve.
+  /// solver; no path followed yet: solve() runs on the SNES's own solver) or the solve fails. The labels' error estimate uses it as its coarse solve.
   /// Collective.
   bool apply_tangent_factor(Vec x, Vec y);
 
