@@ -367,17 +367,20 @@ bool TwoLevelEstimator::fine_newton(Vec Pu, double alpha, Vec e, ErrorEstimate& 
     out.krylov_iterations += int(its);
     if (reason <= 0) return false;
     double lambda = energy_search(x, dx, alpha, w, out);
+    bool fell_back = false;
     if (lambda == 0 && it == 0) {
       // No descent along the Newton step of an indefinite fine tangent (two Random2D load cases
       // of 44 once the step was solved to its tolerance): the two-grid preconditioner's own
-      // step (a symmetric cycle on the coarse factor) instead.
+      // step (a symmetric cycle on the coarse factor) instead, and Newton on from there (that
+      // step alone gave half the u_{h/2} - u_h of a Random3D case).
       PC pc;
       HS_PETSC(KSPGetPC(ksp_, &pc));
       HS_PETSC(PCApply(pc, r, dx));
       lambda = energy_search(x, dx, alpha, w, out);
+      fell_back = true;
     }
     const bool accepted = lambda > 0;
-    full_step = full_step && lambda == 1.0;
+    full_step = full_step && lambda == 1.0 && !fell_back;
     // No descent after an accepted (cut) step: keep that state (flagged: not converged). With
     // the better-converged steps of the SOR smoother, two first load cases of 18 (Random2D
     // shapes 2 and 5) found none at their second step, round-off near the minimum.
