@@ -31,9 +31,12 @@ int main(int argc, char** argv) {
   app.add_option("--degree", o.degree, "element degree (default: the preset's)")->check(CLI::IsMember({1, 2}));
   app.add_option("--h", o.h, "element size (default: the preset's)")->check(CLI::PositiveNumber);
   app.add_option("--levels", o.levels, "reference refinements (default 2 in 2D, 1 in 3D)")->check(CLI::Range(1, 3));
+  bool estimate_only = false;
+  app.add_flag("--estimate-only", estimate_only, "no references: solve and estimate only (the estimate's cost and values)");
   app.add_option("--out", out_file, "JSON lines output (default stdout); appended to");
   try {
     app.parse(int(ours.size()), ours.data());
+    o.references = !estimate_only;
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }

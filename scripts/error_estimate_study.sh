@@ -2,7 +2,7 @@
 # The validation of the labels' error estimate in docs/ACCURACY.md ("Every label knows its own
 # error"): build/study_error_estimate on the accuracy study's scenes and on random Random2D /
 # Random3D load cases, then scripts/error_estimate_report.py (table + log-log plot).
-#   scripts/error_estimate_study.sh [PART...]    parts: random2d scenes2d p2 random3d scenes3d report
+#   scripts/error_estimate_study.sh [PART...]    parts: random2d scenes2d p2 random3d random3d_h03 scenes3d report
 #                                                (default: all; each appends to docs/error_estimate/PART.jsonl)
 # One rank, OPENBLAS_NUM_THREADS=1; references with MUMPS (-ref_ prefix). Runtime on the shared
 # 2-core VM: random2d ~10 min, scenes2d ~5, p2 ~10, random3d/scenes3d ~10 each.
@@ -26,6 +26,8 @@ for part in "${parts[@]}"; do
     random3d)  # Random3D shapes (P2) as the preset solves them, coarser (mesh.h 0.5) so that a
                # reference two refinements finer stays within reach of one core
       "$BIN" --preset random3d --h 0.5 --shapes 0 1 2 3 4 --loads 2 --levels 2 --out "$OUT/random3d.jsonl" -- "${ref[@]}" ;;
+    random3d_h03)  # the preset's own mesh (mesh.h 0.3), one reference refinement (~35k unknowns)
+      "$BIN" --preset random3d --shapes $(seq 0 9) --loads 1 --levels 1 --out "$OUT/random3d_h03.jsonl" -- "${ref[@]}" ;;
     scenes3d)
       "$BIN" --scene ball --h 0.5 --levels 2 --out "$OUT/scenes3d.jsonl" -- "${ref[@]}" ;;
     report)

@@ -24,9 +24,9 @@ LabelErrorEstimator::LabelErrorEstimator(MPI_Comm group, const config::DatasetCo
 }
 
 solver::ErrorEstimate LabelErrorEstimator::estimate(const config::DatasetConfig& cfg, const LoadCase& lc, Vec u,
-                                                    double alpha) {
+                                                    double alpha, const solver::CoarseSolve& coarse_solve) {
   fine_.set_load_case(cfg, fine_shape_, lc);
-  return estimator_->estimate(u, alpha);
+  return estimator_->estimate(u, alpha, coarse_solve);
 }
 
 
@@ -82,13 +82,13 @@ std::string LabelErrorSummary::line() const {
 
 void LabelErrors::estimate(MPI_Comm group, const config::DatasetConfig& cfg, const ShapeSample& shape,
                            const LoadCase& first, const LoadCase& lc, const physics::Problem& coarse, Vec u,
-                           double alpha) {
+                           double alpha, const solver::CoarseSolve& coarse_solve) {
   if (!enabled_) return;
   const auto L = std::size_t(lc.load_id);
   try {
     if (!estimator_) estimator_ = std::make_unique<LabelErrorEstimator>(group, cfg, shape, first, coarse);
     rel_l2_[L] = max_u_[L] = alpha_[L] = -1;  // no estimate (until it is formed)
-    const solver::ErrorEstimate e = estimator_->estimate(cfg, lc, u, alpha);
+    const solver::ErrorEstimate e = estimator_->estimate(cfg, lc, u, alpha, coarse_solve);
     if (!e.ok) return;
     rel_l2_[L] = e.rel_l2;
     max_u_[L] = e.max_u;

@@ -37,7 +37,8 @@ void trial_solve(const config::DatasetConfig& cfg) {
   // the -error_estimate_ksp_* options.
   LabelErrors errors(cfg, 1);
   if (r.converged && errors.enabled())
-    errors.estimate(PETSC_COMM_SELF, cfg, shape, lc, lc, *sp.problem, nl.solution(), r.alpha);
+    errors.estimate(PETSC_COMM_SELF, cfg, shape, lc, lc, *sp.problem, nl.solution(), r.alpha,
+                    [&](Vec x, Vec y) { return nl.apply_tangent_factor(x, y); });
 }
 
 /// Options PETSc reads only in PetscFinalize (or at start-up, for the whole process): no

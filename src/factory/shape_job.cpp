@@ -479,7 +479,9 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
     table.max_u[L] = o.max_u, table.min_det[L] = o.min_det, table.alpha[L] = o.result.alpha;
     {
       auto t = out.times.scope("error_estimate");
-      label_errors.estimate(group, cfg, *shape, cases[0], cases[L], *sp.problem, nl->solution(), o.result.alpha);
+      // The coarse level: the factor the solve left (no second coarse factorisation).
+      label_errors.estimate(group, cfg, *shape, cases[0], cases[L], *sp.problem, nl->solution(), o.result.alpha,
+                            [&](Vec x, Vec y) { return nl->apply_tangent_factor(x, y); });
     }
     if (!root) continue;
     auto t = out.times.scope("representations");

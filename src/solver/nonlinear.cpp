@@ -295,6 +295,10 @@ LinearCounters NonlinearSolver::linear_counters() const {
   return n;
 }
 
+bool NonlinearSolver::apply_tangent_factor(Vec x, Vec y) {
+  return !tangent_->multigrid() && tangent_->has_factor() && tangent_->apply_factor(x, y);
+}
+
 bool NonlinearSolver::rest_response() {
   if (!tangent_->use_rest_factor(u_)) return tangent_response(false);
   negative_pivots_ = -1;

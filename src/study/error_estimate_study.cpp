@@ -133,7 +133,8 @@ void run_shape(const config::DatasetConfig& cfg, const factory::ShapeSample& sha
   }
   std::cerr << fmt::format("[estimate study] {} shape {}: {} dofs, references {} (set-up {:.1f} s)\n", label,
                            shape.shape_id, sp.problem->space().n_dofs_global(),
-                           levels.back().problem.problem->space().n_dofs_global(), core::now_seconds() - t_setup);
+                           levels.empty() ? 0 : levels.back().problem.problem->space().n_dofs_global(),
+                           core::now_seconds() - t_setup);
   for (const auto& lc : cases) {
     json j{{"case", label}, {"dim", cfg.shapes.dim}, {"degree", sp.problem->space().degree()},
            {"shape", shape.shape_id}, {"load", lc.load_id}, {"target", lc.target},
@@ -147,7 +148,8 @@ void run_shape(const config::DatasetConfig& cfg, const factory::ShapeSample& sha
     j["solve_factorizations"] = r.linear.numeric_factorizations;
     j["newton_iterations"] = r.newton_iterations;
     if (r.converged) {
-      const auto e = est.estimate(cfg, lc, nl.solution(), r.alpha);
+      const auto e = est.estimate(cfg, lc, nl.solution(), r.alpha,
+                                  [&](Vec x, Vec y) { return nl.apply_tangent_factor(x, y); });
       j["alpha"] = r.alpha;
       j["estimate_ok"] = e.ok;
       j["est_rel_l2"] = e.rel_l2;
@@ -166,7 +168,9 @@ void run_shape(const config::DatasetConfig& cfg, const factory::ShapeSample& sha
       std::vector<std::vector<double>> u;
       std::vector<double> alphas;
       std::string why;
-      if (solve_references(levels, cfg, lc, r.alpha, u, alphas, why))
+      if (levels.empty())
+        ;  // --estimate-only
+      else if (solve_references(levels, cfg, lc, r.alpha, u, alphas, why))
         true_errors(levels, sp.problem->gather(nl.solution()).values, u, alphas, r.alpha, sp.problem->space().degree(), j);
       else
         j["reference_failed"] = why;
@@ -190,7 +194,7 @@ void run_estimate_study(const EstimateStudyOptions& o, std::ostream& out) {
   if (o.degree) cfg.degree = o.degree;
   const int d = cfg.shapes.dim;
   if (o.h > 0) (d == 3 && cfg.shapes.mesh_h > 0 ? cfg.shapes.mesh_h : cfg.shapes.h) = o.h;
-  const int n_levels = o.levels > 0 ? o.levels : (d == 2 ? 2 : 1);
+  const int n_levels = !o.references ? 0 : o.levels > 0 ? o.levels : (d == 2 ? 2 : 1);
   const std::string label = fmt::format("{}-P{}-h{:g}", o.scene.empty() ? o.preset : o.scene, cfg.degree,
                                         accuracy::preset_mesh_h(cfg));
   if (!o.scene.empty()) {

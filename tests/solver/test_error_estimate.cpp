@@ -188,3 +188,40 @@ TEST_CASE("The estimate of the manufactured solution converges at the L2 rate", 
     }
   }
 }
+
+TEST_CASE("The estimate on the solver's factor is the estimate on its own", "[error_estimate]") {
+  // The factory passes the nonlinear solver's factor as the coarse level (a tangent one Newton
+  // step before u_h); the estimator's own factorisation of K_c(u_h) must give the same estimate
+  // up to the fine solve's tolerance, and without a factor the estimate says so (ok = false).
+  auto effects = [] {
+    std::vector<physics::EffectPtr> e;
+    e.push_back(physics::make_neo_hookean(500, 0.45));
+    e.push_back(physics::make_dirichlet("clamp", hstest::on_plane(0, 0.0), {0, 1}));
+    e.push_back(physics::make_surface_traction(
+        [](const double* x, double* t) { t[0] = 0, t[1] = -std::exp(-20 * (x[0] - 0.8) * (x[0] - 0.8)); },
+        hstest::on_plane(1, 1.0)));
+    return e;
+  };
+  Pair p = make_pair(mesh::mesh_box(2, 1.0, 0.125), 1, effects);
+  solver::NonlinearSolver fresh(*p.coarse, solver::SolverOptions{});
+  Vec x = p.coarse->load();
+  core::VecH y = p.coarse->create_vector();
+  CHECK_FALSE(fresh.apply_tangent_factor(x, y));  // nothing factorised yet
+  solver::NonlinearSolver ns(*p.coarse, solver::SolverOptions{});
+  const auto t = ns.solve_for_target(0.2);
+  REQUIRE(t.converged);
+  const solver::ErrorEstimate own = p.est->estimate(ns.solution(), t.alpha);
+  const solver::ErrorEstimate kept =
+      p.est->estimate(ns.solution(), t.alpha, [&](Vec b, Vec z) { return ns.apply_tangent_factor(b, z); });
+  REQUIRE(own.ok);
+  REQUIRE(kept.ok);
+  INFO("own " << own.rel_l2 << " kept " << kept.rel_l2 << " its " << own.krylov_iterations << " / " << kept.krylov_iterations);
+  CHECK(own.rel_l2 > 1e-3);
+  CHECK(std::abs(kept.rel_l2 / own.rel_l2 - 1) < 0.05);
+  CHECK(std::abs(kept.alpha / own.alpha - 1) < 0.05);
+  CHECK(own.factorizations == 1);
+  CHECK(kept.factorizations == 0);
+  const solver::ErrorEstimate none =
+      p.est->estimate(ns.solution(), t.alpha, [&](Vec b, Vec z) { return fresh.apply_tangent_factor(b, z); });
+  CHECK_FALSE(none.ok);
+}

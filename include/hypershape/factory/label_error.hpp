@@ -26,9 +26,10 @@ class LabelErrorEstimator {
   /// `group`.
   LabelErrorEstimator(MPI_Comm group, const config::DatasetConfig& cfg, const ShapeSample& shape,
                       const LoadCase& first, const physics::Problem& coarse);
-  /// Sets the fine problem to load case `lc` and estimates the error of `u` at `alpha`.
-  /// Collective.
-  solver::ErrorEstimate estimate(const config::DatasetConfig& cfg, const LoadCase& lc, Vec u, double alpha);
+  /// Sets the fine problem to load case `lc` and estimates the error of `u` at `alpha`
+  /// (`coarse_solve`: the nonlinear solver's factor, TwoLevelEstimator::estimate). Collective.
+  solver::ErrorEstimate estimate(const config::DatasetConfig& cfg, const LoadCase& lc, Vec u, double alpha,
+                                 const solver::CoarseSolve& coarse_solve = {});
   const physics::Problem& fine() const { return *fine_.problem; }
   const mesh::RefinedMesh& refined() const { return refined_; }
   const solver::TwoLevelEstimator& estimator() const { return *estimator_; }
@@ -61,10 +62,11 @@ struct LabelErrorSummary {
 class LabelErrors {
  public:
   LabelErrors(const config::DatasetConfig& cfg, int n_loads);
-  /// Estimates load case `lc` (converged: u at alpha). Collective over `group`; a failure
-  /// leaves -1 (a PETSc error is logged), never thrown.
+  /// Estimates load case `lc` (converged: u at alpha, `coarse_solve` the solver's factor).
+  /// Collective over `group`; a failure leaves -1 (a PETSc error is logged), never thrown.
   void estimate(MPI_Comm group, const config::DatasetConfig& cfg, const ShapeSample& shape, const LoadCase& first,
-                const LoadCase& lc, const physics::Problem& coarse, Vec u, double alpha);
+                const LoadCase& lc, const physics::Problem& coarse, Vec u, double alpha,
+                const solver::CoarseSolve& coarse_solve);
   /// Appends the three arrays (group root).
   void store(std::vector<io::Array>& arrays) const;
   bool enabled() const { return enabled_; }

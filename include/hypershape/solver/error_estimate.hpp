@@ -5,9 +5,10 @@
 /// scene on the uniformly refined mesh (mesh::refine_uniform, same degree), and one Newton step
 /// of the fine problem is taken from there at the same load:
 ///   K_f(P u_h) e = -R_f(P u_h),
-/// solved by CG with a two-grid preconditioner (PCMG: the coarse tangent K_c(u_h), factorised
-/// once, as the coarse level, P as the interpolation, Chebyshev/Jacobi smoothing on the fine
-/// level; a few tens of iterations, no fine factorisation). P u_h + e is the fine solution
+/// solved by GMRES with a two-grid preconditioner (PCMG: a factor of the coarse tangent as the
+/// coarse level -- the one the nonlinear solve left, or K_c(u_h) factorised here --, P as the
+/// interpolation, symmetric Gauss-Seidel smoothing on the fine level; a few iterations, no
+/// fine factorisation). P u_h + e is the fine solution
 /// u_{h/2} to second order, so e estimates u_{h/2} - u_h, and
 ///   u - u_h ~ theta e,   theta = 1 / (1 - 2^-q)
 /// for an error falling like h^q (q: -error_estimate_order, default 1: the order measured for
@@ -17,8 +18,11 @@
 ///   alpha  = -max_u max|u_h| / (alpha dmax/dalpha)       (signed: the traction for the target)
 /// A first try solved the tangent on the new dofs only (the hierarchical estimate, CG + Jacobi):
 /// it missed the global, too-stiff part of the error (100x too small on Random2D, docs/ACCURACY.md).
+#include <functional>
 #include <memory>
 #include <vector>
+
+#include <petscpc.h>
 
 #include "hypershape/core/petsc_handle.hpp"
 #include "hypershape/mesh/refine.hpp"
@@ -46,6 +50,9 @@ struct ErrorEstimate {
 double l2_norm_squared(int dim, int degree, const std::vector<double>& coords,
                        const std::vector<std::int64_t>& cells, const std::vector<double>& field, int n_comp);
 
+/// y = K_c^-1 x with a factor of the coarse tangent at (or next to) u_h; false on failure.
+using CoarseSolve = std::function<bool(Vec x, Vec y)>;
+
 class TwoLevelEstimator {
  public:
   /// `coarse`: the solved problem; `fine`: the same scene on `refined.mesh` (same degree), whose
@@ -58,9 +65,12 @@ class TwoLevelEstimator {
   TwoLevelEstimator& operator=(const TwoLevelEstimator&) = delete;
 
   /// Estimates the error of `u_h` (a global vector of the coarse problem) at load factor
-  /// `alpha`; the fine problem must carry the same load case. Collective. Never throws for a
-  /// numerical failure (ok = false); PETSc errors throw core::PetscError.
-  ErrorEstimate estimate(Vec u_h, double alpha) const;
+  /// `alpha`; the fine problem must carry the same load case. `coarse_solve`: a factor of the
+  /// coarse tangent the caller already holds (NonlinearSolver::apply_tangent_factor), the
+  /// two-grid solver's coarse level and du/dalpha; empty: K_c(u_h) is assembled and factorised
+  /// here (one assembly and one numeric factorisation more per estimate). Collective. Never
+  /// throws for a numerical failure (ok = false); PETSc errors throw core::PetscError.
+  ErrorEstimate estimate(Vec u_h, double alpha, const CoarseSolve& coarse_solve = {}) const;
 
   /// P u: a coarse global vector prolonged into a fine global vector. Collective.
   void prolong(Vec coarse, Vec fine) const;
@@ -71,6 +81,14 @@ class TwoLevelEstimator {
  private:
   /// Newton on the fine problem from P u_h (the two-grid solver set up): e = u_fine - P u_h.
   bool fine_newton(Vec Pu, double alpha, Vec e, ErrorEstimate& out) const;
+  /// The largest step lambda in {1, 1/2, ..., > 0.03} with E(x + lambda dx) <= E(x) (w: that
+  /// state), or 0. Energy evaluations counted in out.seconds_assembly.
+  double energy_search(Vec x, Vec dx, double alpha, Vec w, ErrorEstimate& out) const;
+  /// The coarse level: y = K_c^-1 x by `coarse_` (the caller's factor) or by `direct_`.
+  void coarse_apply(Vec x, Vec y) const;
+  static PetscErrorCode apply_coarse(PC pc, Vec x, Vec y);
+  /// Sets up the coarse solve of one estimate (the caller's factor, or K_c(u_h) factorised).
+  bool prepare_coarse(Vec u_h, const CoarseSolve& coarse_solve, ErrorEstimate& out) const;
   const physics::Problem& coarse_;
   const physics::Problem& fine_;
   /// Prolongation in canonical numbering (every rank): fine node i = sum_k w[k] coarse node
@@ -79,9 +97,16 @@ class TwoLevelEstimator {
   std::vector<double> w_;
   core::MatH P_;                 ///< the same in global dofs (constrained dofs dropped)
   mutable core::MatH Kf_, Kc_;  ///< fine and coarse tangents, allocated at the first estimate
-  /// The two-grid solver, kept: the coarse factorisation's symbolic phase (ordering) is done
-  /// once per shape, each estimate refactorises numerically only.
+  /// The two-grid solver, kept (its coarse level a PC shell: apply_coarse).
   mutable core::KSPH ksp_;
+  /// Without a caller's factor: the direct solver of K_c(u_h), kept (the symbolic phase once
+  /// per shape, a numeric refactorisation per estimate).
+  mutable core::KSPH direct_;
+  mutable CoarseSolve coarse_solve_;  ///< the caller's factor during one estimate
+  mutable bool coarse_failed_ = false;
+  /// Work vectors (fine: x, r, dx, w, g, P u_h, e; coarse: du/dalpha), made at the first estimate.
+  mutable std::vector<core::VecH> fv_;
+  mutable core::VecH du_dalpha_;
 };
 
 }  // namespace hypershape::solver

@@ -102,6 +102,8 @@ class Tangent {
   LinearSolver linear_solver() const { return linear_; }
   /// The factor in use is of the assembled tangent (no assembly since the factorisation).
   bool factor_is_current() const { return current_; }
+  /// A factor is in use (none before the first factorisation).
+  bool has_factor() const { return use_rest_ || work_->factored(); }
   Mat matrix() const { return J_.get(); }
   const LinearCounters& counters() const { return n_; }
   const TangentOptions& options() const { return opt_; }

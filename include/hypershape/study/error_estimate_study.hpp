@@ -19,6 +19,7 @@ struct EstimateStudyOptions {
   int degree = 0;                      ///< 0: the preset's
   double h = 0;                        ///< 0: the preset's (2D shapes.h, 3D mesh.h)
   int levels = 0;                      ///< reference refinements (0: 2 in 2D, 1 in 3D)
+  bool references = true;              ///< false: solve and estimate only (no truth; cost and estimate comparisons)
 };
 
 /// Runs the cases, one JSON line each on `out` (flushed), progress on stderr. One rank, inside
