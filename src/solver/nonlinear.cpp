@@ -400,7 +400,13 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
       why = "non-finite residual";
       return false;
     }
-    if (rn <= opt_.atol + rtol * std::abs(s_) * fnorm && std::abs(g) <= gtol) {
+    // An intermediate state gets at least one corrector iteration, even where the predictor
+    // landed within path_rtol: the next increment's predictor and its inertia need the tangent
+    // of this state (a_ and negative_pivots_ would be two states old). Measured on Random2D
+    // (8 shapes x 25 load cases, P1): 8 states accepted unrefreshed, the increments after them
+    // failed 32 times; with the iteration 14.1 -> 13.3 Newton iterations per load case.
+    const bool refreshed = k > 0 || rtol <= opt_.rtol;
+    if (refreshed && rn <= opt_.atol + rtol * std::abs(s_) * fnorm && std::abs(g) <= gtol) {
       // The final state's stability check needs the inertia of its own tangent: with a kept
       // factor (of an earlier state) it is factorised here, once per target solve.
       if (rtol <= opt_.rtol && opt_.tangent.reuse && !factorise_here()) {
@@ -743,8 +749,14 @@ TargetResult NonlinearSolver::follow_path(double target, double start, int spent
       first_accepted = false;
       d = d_next;
       if (last) break;
+      // Step control by the corrector's count: double after <= 2 iterations, halve after >= 6.
+      // Measured on Random2D (8 x 25, P1): the increment after a doubling failed in 13%, 11%
+      // and 18% of cases after 1, 2 and 3 iterations (a failure costs 5.7 iterations, an
+      // accepted intermediate increment 3.1); doubling after <= 3 and halving after >= 8
+      // (before): 13.3 Newton iterations per load case, this rule 12.6 (0.24 failed increments
+      // per load case against 0.34), all 200 converged.
       const int n = its - its_before;
-      if (n <= 3) step *= 2.0; else if (n >= 8) step *= 0.5;
+      if (n <= 2) step *= 2.0; else if (n >= 6) step *= 0.5;
       continue;
     }
     ++t.failed_increments;

@@ -28,8 +28,9 @@
 ///     det F <= 0), alpha moving by the same fraction; intermediate increments are converged
 ///     to path_rtol only, the last to rtol;
 ///   - an increment that fails (max_newton iterations, or no progress after 4) is discarded,
-///     the state restored and the increment halved; after an easy success (<= 3 iterations) it
-///     doubles, after a hard one (>= 8) it halves (FEBio-style);
+///     the state restored and the increment halved; after an easy success (<= 2 iterations) it
+///     doubles, after a hard one (>= 6) it halves (FEBio-style); an intermediate increment
+///     takes at least one corrector iteration (the next predictor needs its tangent);
 ///   - the first increment from rest is the previous load case's first; max_halvings failures
 ///     in a row, or increments below 1e-3 of the way, end the path; limit points of the load
 ///     are passed (alpha may fall);
