@@ -198,14 +198,16 @@ class NonlinearSolver {
   /// The eigenvector of K(u_) whose eigenvalue is nearest zero (inverse iteration from a
   /// rank-independent pseudo-random vector), in v_, |v_|_inf = 1; returns its Rayleigh quotient.
   double softest_mode();
-  /// Minimises the energy at load factor s from u_ by Newton with an inertia correction:
-  /// K + mu I, mu raised until LDL^T has no negative pivot, lowered after full steps. Ends at
+  /// Minimises the energy at load factor s from u_ by a trust-region Newton method: steps of at
+  /// most `radius` (|.|_inf; from `eps`, doubled after full steps that filled it, cut to what
+  /// the guarded line search took), through curvature_step where K(u_) is indefinite. Ends at
   /// an equilibrium whose tangent is positive definite, or returns false with `why`.
-  /// `eps`: the length of a step along negative curvature (descend_softest_mode).
   bool minimise(double s, double eps, int& its, std::string& why);
-  /// Where K(u_) is factorised and indefinite: moves u_ along the softest mode (eigenvalue < 0)
-  /// by the first of eps, eps/2, ... that lowers the energy at load s. False if none does.
-  bool descend_softest_mode(double s, double eps);
+  /// With K(u_) assembled and factorised (`negative` negative pivots) and R in r_: the step
+  /// u_ - du_. Indefinite K: shifted past the softest mode's eigenvalue (mu0, 4 mu0, ... where
+  /// that estimate is not negative) until LDL^T has no negative pivot, plus a move along the mode
+  /// (energy-descending sign) that fills the trust region. False if no shift factorised.
+  bool curvature_step(double radius, double mu0, int negative);
 
   const physics::Problem& problem_;
   SolverOptions opt_;
