@@ -504,20 +504,18 @@ bool NonlinearSolver::curvature_step(double radius, double mu0, int negative) {
   // 1e-3 long and led back (seed 777, shape 5, load 26: the same 4 iterations 12 times).
   double mu = 0, dsign = 0;
   if (negative > 0) {
-    const double lam = softest_mode();  // the factor in use is of K itself: nearest zero
+    const double lam = softest_mode();  // v_; the factor in use is of K itself
+    if (lam < 0) {
+      PetscReal rv;
+      HS_PETSC(VecDot(r_, v_, &rv));
+      dsign = rv > 0 ? -1.0 : 1.0;  // the energy's slope along +v_ is R . v_
+    }
     double target = lam < 0 ? -2 * lam : mu0;
     for (int k = 0; k < 12; ++k, target *= 4) {
       tangent_->shift(target - mu);
       mu = target;
       if (tangent_->factorise() && tangent_->negative_eigenvalues() == 0) break;
       if (k == 11) return false;
-    }
-    // K + mu I is positive definite: its softest mode is K's most negative one (the mode
-    // nearest zero above may have been a positive one).
-    if (softest_mode() - mu < 0) {
-      PetscReal rv;
-      HS_PETSC(VecDot(r_, v_, &rv));
-      dsign = rv > 0 ? -1.0 : 1.0;  // the energy's slope along +v_ is R . v_
     }
   }
   if (!tangent_->apply_factor(r_, du_)) return false;  // u - du_: the (shifted) Newton step

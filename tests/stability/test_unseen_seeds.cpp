@@ -3,7 +3,8 @@
 /// earlier load case of the shape), each must reach a verified stable equilibrium on target.
 /// Seed 2024, shape 12, load 17 failed with the minimisation of 2026-11-24 (fixed shifts and a
 /// straight move of eps along negative curvature): its three minimisations did not converge
-/// (48, 48 and 9 iterations) and the Newton budget was spent.
+/// (48, 48 and 9 iterations) and the Newton budget was spent (the same solve by the replay below,
+/// SEED=2024 SHAPE=12 LOAD=17 FROM=17, with that solver: FAILED, 200 its).
 #include <catch2/catch.hpp>
 
 #include <cstdlib>
