@@ -506,29 +506,42 @@ double NonlinearSolver::softest_mode() {
   return vkv / vv;
 }
 
-bool NonlinearSolver::descend_softest_mode(double s, double eps) {
-  if (!(softest_mode() < 0)) return false;  // v_: the mode of K's eigenvalue nearest zero
-  PetscReal rv;
-  HS_PETSC(VecDot(r_, v_, &rv));  // the energy's slope along +v_ is R . v_
-  const double sign = rv > 0 ? -1.0 : 1.0;
-  double e0;
-  if (!problem_.energy(u_, s, e0)) return false;
-  auto energy_at = [&](double t) {
-    HS_PETSC(VecWAXPY(w_, sign * t, v_, u_));
-    double e;
-    return problem_.energy(w_, s, e) ? e : INFINITY;
-  };
-  double t = eps;  // the first of eps, eps/2, ... that lowers the energy
-  while (!(energy_at(t) < e0))
-    if ((t *= 0.5) < 1e-3 * eps) return false;
-  HS_PETSC(PetscInfo(snes_.get(), "minimise: a step of %g along negative curvature\n", t));
-  HS_PETSC(VecAXPY(u_, sign * t, v_));
+bool NonlinearSolver::curvature_step(double radius, double mu0, int negative) {
+  // Moré-Sorensen-like: where K is indefinite, shift it just past its most negative eigenvalue
+  // (estimated by the softest mode) and add a move along that mode so that the step fills the
+  // trust region. The former fixed shifts (mu0, 4 mu0, ...; lowered by 4 after full steps) with a
+  // straight-line move of eps along the mode cycled at saddle plateaus: the shifted steps were
+  // 1e-3 long and led back (seed 777, shape 5, load 26: the same 4 iterations 12 times).
+  double mu = 0, dsign = 0;
+  if (negative > 0) {
+    const double lam = softest_mode();  // v_; the factor in use is of K itself
+    if (lam < 0) {
+      PetscReal rv;
+      HS_PETSC(VecDot(r_, v_, &rv));
+      dsign = rv > 0 ? -1.0 : 1.0;  // the energy's slope along +v_ is R . v_
+    }
+    double target = lam < 0 ? -2 * lam : mu0;
+    for (int k = 0; k < 12; ++k, target *= 4) {
+      tangent_->shift(target - mu);
+      mu = target;
+      if (tangent_->factorise() && tangent_->negative_eigenvalues() == 0) break;
+      if (k == 11) return false;
+    }
+  }
+  if (!tangent_->apply_factor(r_, du_)) return false;  // u - du_: the (shifted) Newton step
+  PetscReal dmax;
+  HS_PETSC(VecNorm(du_, NORM_INFINITY, &dmax));
+  if (dsign != 0 && dmax < radius) HS_PETSC(VecAXPY(du_, -dsign * (radius - dmax), v_));
+  HS_PETSC(VecNorm(du_, NORM_INFINITY, &dmax));
+  if (dmax > radius) HS_PETSC(VecScale(du_, radius / dmax));
+  HS_PETSC(PetscInfo(snes_.get(), "minimise: %d negative pivot(s), shift %g, step %g (radius %g)%s\n", negative, mu,
+                     std::min(double(dmax), radius), radius, dsign != 0 ? ", along negative curvature" : ""));
   return true;
 }
 
 bool NonlinearSolver::minimise(double s, double eps, int& its, std::string& why) {
-  const double fnorm = problem_.load_norm();
-  double mu = 0, mu0 = 0;
+  const double tol = opt_.atol + opt_.rtol * std::abs(s) * problem_.load_norm();
+  double mu0 = 0, radius = eps;
   for (int k = 0;; ++k) {
     if (!problem_.residual(u_, s, r_)) {
       why = "inadmissible state (det F <= 0)";
@@ -540,17 +553,18 @@ bool NonlinearSolver::minimise(double s, double eps, int& its, std::string& why)
       why = "non-finite residual";
       return false;
     }
-    if (mu == 0 && negative_pivots_ == 0 && rn <= opt_.atol + opt_.rtol * std::abs(s) * fnorm) return true;
     if (k == 4 * opt_.max_newton || its >= opt_.newton_budget) {
       why = "energy minimisation: no convergence in " + std::to_string(k) + " iterations";
       return false;
     }
-    ++its;
-    if (!tangent_->assemble(u_)) {
-      why = "tangent could not be formed";
+    // The inertia of K(u) itself: a factorisation of this very tangent.
+    if (!factorise_here()) {
+      why = "tangent could not be formed or factorised";
       return false;
     }
-    if (mu0 == 0) {  // the shift's scale: the mean diagonal entry of the tangent
+    if (negative_pivots_ == 0 && rn <= tol) return true;
+    ++its;
+    if (mu0 == 0) {  // the shift's scale where no negative eigenvalue is estimated
       HS_PETSC(MatGetDiagonal(tangent_->matrix(), w_));
       PetscReal sum;
       PetscInt n;
@@ -558,36 +572,22 @@ bool NonlinearSolver::minimise(double s, double eps, int& its, std::string& why)
       HS_PETSC(VecGetSize(w_, &n));
       mu0 = 1e-3 * std::abs(sum) / double(n);
     }
-    if (mu > 0) tangent_->shift(mu);
-    // The inertia decides the shift: a factorisation of this very (shifted) tangent.
-    const bool solved = tangent_->factorise() && tangent_->apply_factor(r_, du_);
-    negative_pivots_ = solved ? tangent_->negative_eigenvalues() : -1;
-    if (solved && mu == 0 && negative_pivots_ > 0 && descend_softest_mode(s, eps)) {
-      // Indefinite where the shifted steps had led: a saddle's neighbourhood, whose gradient
-      // is too small for a shifted Newton step to leave it (measured: the shift cycled, the
-      // residual stalled, 48 iterations). Its way down is along negative curvature.
-      mu = mu0 / 4;
-      negative_pivots_ = -1;
-      continue;
+    if (!curvature_step(radius, mu0, negative_pivots_)) {
+      why = "shifted tangent could not be factorised";
+      return false;
     }
-    if (!solved || negative_pivots_ != 0) {  // indefinite (or failed): shift further
-      mu = mu == 0 ? mu0 : 4 * mu;
-      negative_pivots_ = -1;
-      continue;
-    }
+    PetscReal ymax;
+    HS_PETSC(VecNorm(du_, NORM_INFINITY, &ymax));
     const double lambda = backtrack(u_, du_, r_, s, w_, b_);
-    HS_PETSC(PetscInfo(snes_.get(), "minimise %d: |R| %g (%g to go), shift %g, step %g\n", k, rn,
-                       rn / (opt_.atol + opt_.rtol * std::abs(s) * fnorm), mu, lambda));
+    HS_PETSC(PetscInfo(snes_.get(), "minimise %d: |R| %g (%g to go), step %g x %g\n", k, rn, rn / tol, lambda, ymax));
     if (lambda == 0.0) {
-      mu = mu == 0 ? mu0 : 4 * mu;
-      negative_pivots_ = -1;
+      radius = 0.25 * std::min(radius, double(ymax));
       continue;
     }
     HS_PETSC(VecCopy(w_, u_));
-    if (mu > 0) {
-      negative_pivots_ = -1;  // the inertia of K itself is not known yet
-      if (lambda == 1.0) mu = mu < mu0 / 16 ? 0.0 : mu / 4;
-    }
+    // Grow the region after a full step that filled it, shrink it to what the line search took.
+    if (lambda == 1.0 && ymax >= 0.99 * radius) radius = std::min(2 * radius, 20 * eps);
+    else if (lambda < 1.0) radius = std::max(lambda * ymax, 1e-3 * eps);
   }
 }
 

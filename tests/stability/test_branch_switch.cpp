@@ -17,20 +17,9 @@
 #include "hypershape/factory/shape_job.hpp"
 #include "hypershape/factory/shape_pipeline.hpp"
 #include "hypershape/solver/nonlinear.hpp"
-#include "support/helpers.hpp"
+#include "support/stable_state.hpp"
 
 using namespace hypershape;
-
-namespace {
-
-/// Negative eigenvalues of the tangent at u, by a fresh MUMPS LDL^T.
-int tangent_inertia(const physics::Problem& p, Vec u) {
-  core::MatH K = p.create_matrix();
-  REQUIRE(p.jacobian(u, K));
-  return hstest::ldlt_negative_eigenvalues(K, MATSOLVERMUMPS);
-}
-
-}  // namespace
 
 TEST_CASE("Branch switching turns lost stability into stable equilibria on target", "[stability][branch]") {
   auto cfg = config::parse_dataset_file(std::string(HS_SOURCE_DIR) + "/configs/presets/random2d.yaml");
@@ -57,16 +46,7 @@ TEST_CASE("Branch switching turns lost stability into stable equilibria on targe
               << r0.newton_iterations << " its)\n  with:    " << r.reason << " ("
               << r.newton_iterations << " its, alpha " << r.alpha << ")\n";
     INFO("shape " << shape_id << " load " << load_id << ": " << r.reason);
-    REQUIRE(r.converged);
-    CHECK(std::abs(r.max_displacement / lc.target - 1) <= cfg.solver.target_rtol);
-    core::VecH res = p.create_vector();
-    REQUIRE(p.residual(ns.solution(), r.alpha, res));
-    PetscReal rn;
-    HS_PETSC(VecNorm(res, NORM_2, &rn));
-    CHECK(rn <= cfg.solver.rtol * r.alpha * p.load_norm() + cfg.solver.atol);
-    CHECK(p.min_det_f(ns.solution()) > 0);
-    CHECK(hstest::all_finite(hstest::values(ns.solution())));
-    CHECK(tangent_inertia(p, ns.solution()) == 0);
+    hstest::check_stable_on_target(p, ns.solution(), r, lc.target, cfg.solver);
   }
   CHECK(lost_without >= 1);  // the cases still exercise the switch
 }
