@@ -7,7 +7,7 @@
 #   scripts/bench_stability.sh [SHAPES_2D] [SHAPES_3D]   (default 20 x 50 = 1000 load cases per
 #   seed in 2D, 10 x 20 = 200 in 3D; JSON: results/bench_stability.json)
 #   SEEDS="777 2024 31337" SEEDS3D="4242" scripts/bench_stability.sh   (defaults: the presets' own)
-#   NP=2 (ranks, default 2); SHAPES_3D=0 skips 3D.
+#   NP=2 (ranks, default 2); a second argument of 0 (e.g. `scripts/bench_stability.sh 20 0`) skips 3D.
 #   CONFIGS="configs/examples/catalogue2d.yaml ..." also runs these dataset configs as they are
 #   but for SHAPES_2D shapes x 50 load cases (their shapes: and loads: counts replaced); with
 #   CONFIGS and no SEEDS the preset's own seed is not run:

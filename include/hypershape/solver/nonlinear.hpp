@@ -2,6 +2,14 @@
 /// Nonlinear solves of one Problem: one SNES (and so one matrix, one KSP and one symbolic
 /// factorisation) kept for all its load cases.
 ///
+/// Its pieces, one file each (src/solver/): nonlinear.cpp (set-up, the SNES callbacks, the guarded
+/// line search, solve_for_target), load_control.cpp (Newton at a given load, continuation, the
+/// alpha search of control: load), path_following.cpp (displacement control: predictor,
+/// corrector, the final check), branch_switch.cpp (softest mode, energy minimisation); the
+/// tangent, its factors and Krylov solves in tangent.hpp. Each registers PETSc log events
+/// (HSLoadControl, HSPredictor, HSCorrector, HSBranchSwitch, HSTangentAsm, HSFactor, ...), so
+/// -log_view splits a load case by piece.
+///
 /// Defaults (each overridable in the PETSc options database, prefix "" unless given):
 ///   -snes_type newtonls with our guarded line search (type shell): a trial state with
 ///   det F <= 0 has energy +inf and is never accepted (the "guard"); an admissible one is taken
@@ -171,6 +179,10 @@ class NonlinearSolver {
   /// One increment of the path from the equilibrium in u_/s_ to max|u| = d_next: the tangent
   /// predictor (a_ holds K^-1 f_ext there) and the corrector, to rtol if `last`, else path_rtol.
   bool increment(double d_next, bool last, int& its, std::string& why);
+  /// The tangent predictor of an increment: from the equilibrium in u_/s_ (a_ = K^-1 f_ext there)
+  /// towards max|u| = d_next, damped by the guarded line search. False (`why`) where max|u| does
+  /// not respond to the load.
+  bool predict(double d_next, std::string& why);
   /// The path's result from the state it ended in (`at_target`: its last increment reached
   /// the target): max|u|, alpha, inertia, and the converged state's final check.
   void finish_path(TargetResult& t, bool at_target);
