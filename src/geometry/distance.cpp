@@ -283,6 +283,23 @@ class Bvh {
                      std::vector<std::int32_t>& order, std::int32_t first, std::int32_t last) {
     const auto index = std::int32_t(nodes_.size());
     nodes_.emplace_back();
+    Node node = bound(data, order, first, last);
+    if (last - first <= leaf_size) {
+      node.first = first;
+      node.count = last - first;
+      nodes_[std::size_t(index)] = node;
+      return index;
+    }
+    const std::int32_t mid = median_split(centroid, order, first, last);
+    node.left = build(data, centroid, order, first, mid);
+    node.right = build(data, centroid, order, mid, last);
+    nodes_[std::size_t(index)] = node;
+    return index;
+  }
+
+  /// A node's bounds over facets order[first, last): the axis-aligned box and the oriented box.
+  Node bound(const std::vector<Datum>& data, const std::vector<std::int32_t>& order, std::int32_t first,
+             std::int32_t last) const {
     Node node;
     // Axis-aligned box and area-weighted mean normal.
     node.box = {HUGE_VAL, HUGE_VAL, HUGE_VAL, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
@@ -299,25 +316,7 @@ class Bvh {
       for (int j = 0; j < 3; ++j) normal[std::size_t(j)] += n[std::size_t(j)];
       total += std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     }
-    // Oriented frame: the mean normal if the facets agree on one, else the coordinate axes (the
-    // oriented box is then the axis-aligned one).
-    const double len =
-        std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
-    if (len > 0.5 * total && len > 0) {
-      const Vec w = {normal[0] / len, normal[1] / len, normal[2] / len};
-      // Any unit vector orthogonal to w: cross with the coordinate axis least aligned with it.
-      const int a = std::abs(w[0]) <= std::abs(w[1]) && std::abs(w[0]) <= std::abs(w[2]) ? 0
-                    : std::abs(w[1]) <= std::abs(w[2])                                   ? 1
-                                                                                         : 2;
-      Vec e{0, 0, 0};
-      e[std::size_t(a)] = 1;
-      Vec u = cross(w, e);
-      const double lu = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-      u = {u[0] / lu, u[1] / lu, u[2] / lu};
-      node.axis = {u, cross(w, u), w};
-    } else {
-      node.axis = {Vec{1, 0, 0}, Vec{0, 1, 0}, Vec{0, 0, 1}};
-    }
+    node.axis = frame(normal, total);
     node.lo = {HUGE_VAL, HUGE_VAL, HUGE_VAL};
     node.hi = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
     double scale = 0;
@@ -340,13 +339,33 @@ class Bvh {
       node.lo[std::size_t(j)] -= 1e-12 * scale;
       node.hi[std::size_t(j)] += 1e-12 * scale;
     }
-    if (last - first <= leaf_size) {
-      node.first = first;
-      node.count = last - first;
-      nodes_[std::size_t(index)] = node;
-      return index;
-    }
-    // Median split of the centroids along their longest extent.
+    return node;
+  }
+
+  /// Oriented frame: the mean normal (sum `normal` of facet normals of total length `total`) if
+  /// the facets agree on one, else the coordinate axes (the oriented box is then the
+  /// axis-aligned one).
+  static std::array<Vec, 3> frame(const Vec& normal, double total) {
+    const double len =
+        std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
+    if (!(len > 0.5 * total && len > 0)) return {Vec{1, 0, 0}, Vec{0, 1, 0}, Vec{0, 0, 1}};
+    const Vec w = {normal[0] / len, normal[1] / len, normal[2] / len};
+    // Any unit vector orthogonal to w: cross with the coordinate axis least aligned with it.
+    const int a = std::abs(w[0]) <= std::abs(w[1]) && std::abs(w[0]) <= std::abs(w[2]) ? 0
+                  : std::abs(w[1]) <= std::abs(w[2])                                   ? 1
+                                                                                       : 2;
+    Vec e{0, 0, 0};
+    e[std::size_t(a)] = 1;
+    Vec u = cross(w, e);
+    const double lu = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    u = {u[0] / lu, u[1] / lu, u[2] / lu};
+    return {u, cross(w, u), w};
+  }
+
+  /// Median split of order[first, last) by the centroids along their longest extent; the index
+  /// of the split.
+  static std::int32_t median_split(const std::vector<Vec>& centroid, std::vector<std::int32_t>& order,
+                                   std::int32_t first, std::int32_t last) {
     Vec cmin{HUGE_VAL, HUGE_VAL, HUGE_VAL}, cmax{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
     for (std::int32_t i = first; i < last; ++i)
       for (int j = 0; j < 3; ++j) {
@@ -366,10 +385,7 @@ class Bvh {
                        return centroid[std::size_t(a)][std::size_t(axis)] <
                               centroid[std::size_t(b)][std::size_t(axis)];
                      });
-    node.left = build(data, centroid, order, first, mid);
-    node.right = build(data, centroid, order, mid, last);
-    nodes_[std::size_t(index)] = node;
-    return index;
+    return mid;
   }
 
   static Vec cross(const Vec& a, const Vec& b) {

@@ -235,67 +235,79 @@ std::vector<double> ball_radii(const Boundary& b, bool inward) {
 
 // ---- Hausdorff --------------------------------------------------------------------------------
 
-double directed_hausdorff_impl(const Boundary& from, const detail::FacetTree& to,
-                               double tolerance) {
-  const int dim = from.dim;
-  detail::ClosestHit hit;
-  const auto closest = [&](const Vec& x) {
-    hit = hit.facet < 0 ? to.closest(x.data()) : to.closest(x.data(), hit);
-    return std::pair{std::sqrt(hit.squared_distance), hit.primitive};
-  };
+/// The directed Hausdorff distance from `from` to `to` by branch and bound: a lower bound from
+/// the vertices, then every facet of `from` bisected where its upper bound could still beat the
+/// lower one by more than the tolerance.
+class DirectedHausdorff {
+ public:
+  DirectedHausdorff(const Boundary& from, const detail::FacetTree& to) : from_(from), to_(to), dim_(from.dim) {}
 
-  // Lower bound from the vertices first, so that most facets are pruned at once.
-  const std::int64_t n_points = from.n_points();
-  std::vector<double> d_point(std::size_t(n_points), 0.0);
-  std::vector<std::int64_t> f_point(std::size_t(n_points), -1);
-  double lower = 0;
-  for (const int i : from.facets) {
-    if (f_point[std::size_t(i)] >= 0) continue;
-    std::tie(d_point[std::size_t(i)], f_point[std::size_t(i)]) = closest(point3(from, i));
-    lower = std::max(lower, d_point[std::size_t(i)]);
+  double run(double tolerance) {
+    vertex_pass();
+    for (std::int64_t f = 0; f < from_.n_facets(); ++f) refine_facet(f, tolerance);
+    return lower_;
   }
 
+ private:
   // A simplex of `from`: vertices, their distances to `to` and the facet of `to` realising it.
   struct Simplex {
     std::array<Vec, 3> x;
     std::array<double, 3> d;
     std::array<std::int64_t, 3> f;
   };
+
+  std::pair<double, std::int64_t> closest(const Vec& x) {
+    hit_ = hit_.facet < 0 ? to_.closest(x.data()) : to_.closest(x.data(), hit_);
+    return std::pair{std::sqrt(hit_.squared_distance), hit_.primitive};
+  }
+
+  /// Lower bound from the vertices first, so that most facets are pruned at once.
+  void vertex_pass() {
+    const std::int64_t n_points = from_.n_points();
+    d_point_.assign(std::size_t(n_points), 0.0);
+    f_point_.assign(std::size_t(n_points), -1);
+    for (const int i : from_.facets) {
+      if (f_point_[std::size_t(i)] >= 0) continue;
+      std::tie(d_point_[std::size_t(i)], f_point_[std::size_t(i)]) = closest(point3(from_, i));
+      lower_ = std::max(lower_, d_point_[std::size_t(i)]);
+    }
+  }
+
   // Upper bound of dist(., to) over the simplex. Two bounds, both valid for every x in it:
   //  - Lipschitz: dist(x) <= d_i + |x - v_i| <= d_i + max_j |v_j - v_i|;
   //  - convexity: dist(x) <= dist(x, F_i) for the facet F_i closest to v_i, and dist(., F_i) is
   //    convex, so its max over the simplex is at a vertex. This one is tight where the two
   //    boundaries run parallel (a shape and its offset), where Lipschitz alone would bisect
   //    every facet down to the tolerance.
-  const auto upper_bound = [&](const Simplex& t, double& diam2, int& e0, int& e1) {
+  // diam2, e0, e1: the squared length of the longest edge and its ends.
+  double upper_bound(const Simplex& t, double& diam2, int& e0, int& e1) const {
     double upper = std::numeric_limits<double>::infinity();
     diam2 = 0, e0 = 0, e1 = 1;
-    for (int a = 0; a < dim; ++a) {
+    for (int a = 0; a < dim_; ++a) {
       double far2 = 0, convex2 = 0;
-      for (int c = 0; c < dim; ++c) {
+      for (int c = 0; c < dim_; ++c) {
         const double l2 = norm2(sub(t.x[std::size_t(a)], t.x[std::size_t(c)]));
         far2 = std::max(far2, l2);
         if (l2 > diam2) diam2 = l2, e0 = a, e1 = c;
         convex2 = std::max(convex2, c == a ? t.d[std::size_t(a)] * t.d[std::size_t(a)]
-                                           : to.squared_distance_to(t.x[std::size_t(c)].data(),
-                                                                    t.f[std::size_t(a)]));
+                                           : to_.squared_distance_to(t.x[std::size_t(c)].data(),
+                                                                     t.f[std::size_t(a)]));
       }
       upper = std::min({upper, t.d[std::size_t(a)] + std::sqrt(far2), std::sqrt(convex2)});
     }
     return upper;
-  };
+  }
 
-  std::vector<Simplex> stack;
-  for (std::int64_t f = 0; f < from.n_facets(); ++f) {
-    const auto v = from.facet(f);
+  void refine_facet(std::int64_t f, double tolerance) {
+    const auto v = from_.facet(f);
     Simplex s{};
-    for (int k = 0; k < dim; ++k) {
+    for (int k = 0; k < dim_; ++k) {
       const auto i = std::size_t(v[std::size_t(k)]);
-      s.x[std::size_t(k)] = point3(from, std::int64_t(i));
-      s.d[std::size_t(k)] = d_point[i];
-      s.f[std::size_t(k)] = f_point[i];
+      s.x[std::size_t(k)] = point3(from_, std::int64_t(i));
+      s.d[std::size_t(k)] = d_point_[i];
+      s.f[std::size_t(k)] = f_point_[i];
     }
-    stack.push_back(s);
+    std::vector<Simplex> stack{s};
     while (!stack.empty()) {
       const Simplex t = stack.back();
       stack.pop_back();
@@ -304,10 +316,10 @@ double directed_hausdorff_impl(const Boundary& from, const detail::FacetTree& to
       const double upper = upper_bound(t, diam2, e0, e1);
       // Pruned either because it cannot beat `lower`, or because upper <= max_i d_i + diam <=
       // lower + tolerance: the guarantee of the header.
-      if (upper <= lower || std::sqrt(diam2) <= tolerance) continue;
+      if (upper <= lower_ || std::sqrt(diam2) <= tolerance) continue;
       const Vec m = midpoint(t.x[std::size_t(e0)], t.x[std::size_t(e1)]);
       const auto [dm, fm] = closest(m);
-      lower = std::max(lower, dm);
+      lower_ = std::max(lower_, dm);
       Simplex c0 = t, c1 = t;  // bisect the longest edge
       c0.x[std::size_t(e0)] = m, c0.d[std::size_t(e0)] = dm, c0.f[std::size_t(e0)] = fm;
       c1.x[std::size_t(e1)] = m, c1.d[std::size_t(e1)] = dm, c1.f[std::size_t(e1)] = fm;
@@ -315,7 +327,18 @@ double directed_hausdorff_impl(const Boundary& from, const detail::FacetTree& to
       stack.push_back(c1);
     }
   }
-  return lower;
+
+  const Boundary& from_;
+  const detail::FacetTree& to_;
+  const int dim_;
+  detail::ClosestHit hit_;
+  std::vector<double> d_point_;
+  std::vector<std::int64_t> f_point_;
+  double lower_ = 0;
+};
+
+double directed_hausdorff_impl(const Boundary& from, const detail::FacetTree& to, double tolerance) {
+  return DirectedHausdorff(from, to).run(tolerance);
 }
 
 void check_pair(const Boundary& a, const Boundary& b, double tolerance, const char* what) {

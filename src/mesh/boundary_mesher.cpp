@@ -747,11 +747,10 @@ class SliverRemover {
     return dot(d, d) < dot(center, center);
   }
 
-  /// Tries to insert a new vertex near sliver c (Bowyer-Watson: the tetrahedra connected to c
-  /// through interior faces whose circumsphere holds the point are replaced by its star); true
-  /// if it did. Candidates: c's centroid and points inwards of it and of its boundary faces;
-  /// the best one whose star is valid must beat the worst tetrahedron it replaces.
-  bool insert_vertex(int c) {
+  /// Points to try as a new vertex near sliver c: its centroid, and points inwards (along the
+  /// mean inward normal of its boundary faces, at fractions of its mean edge) of the centroid
+  /// and of each boundary face's centroid.
+  std::vector<Vec3> insertion_candidates(int c) const {
     Vec3 inward{0, 0, 0}, centroid{0, 0, 0};
     std::vector<Vec3> bases;  // the centroid and the centroids of the boundary faces
     double edge = 0;
@@ -783,54 +782,81 @@ class SliverRemover {
           candidates.push_back({base[0] + depth * edge * inward[0] / in_len,
                                 base[1] + depth * edge * inward[1] / in_len,
                                 base[2] + depth * edge * inward[2] / in_len});
+    return candidates;
+  }
+
+  /// The Bowyer-Watson cavity of x grown from tetrahedron c: the tetrahedra connected to c
+  /// through interior faces whose circumsphere holds x.
+  std::vector<int> cavity_of(int c, const Vec3& x) const {
+    std::vector<int> cavity{c}, todo{c};
+    std::set<int> in_cavity{c};
+    while (!todo.empty()) {
+      const int t = todo.back();
+      todo.pop_back();
+      for (int skip = 0; skip < 4; ++skip) {
+        const auto f = sorted_face(tets_[t], skip);
+        if (boundary_faces_.contains(f)) continue;
+        const int u = neighbour(t, f);
+        if (u < 0 || in_cavity.contains(u) || !in_circumsphere(tets_[u], x)) continue;
+        in_cavity.insert(u);
+        cavity.push_back(u);
+        todo.push_back(u);
+      }
+    }
+    return cavity;
+  }
+
+  /// The cavity's boundary faces (keyed by their sorted vertices), oriented with the cavity on
+  /// their positive side.
+  std::map<std::array<int, 3>, std::array<int, 3>> cavity_faces(const std::vector<int>& cavity) const {
+    std::map<std::array<int, 3>, std::array<int, 3>> faces;
+    for (int t : cavity)
+      for (int k = 0; k < 4; ++k) {
+        const auto key = sorted_face(tets_[t], k);
+        if (faces.erase(key)) continue;  // shared by two cavity tetrahedra
+        const Tet& v = tets_[t];
+        std::array<int, 3> face{};
+        int n = 0;
+        for (int a = 0; a < 4; ++a)
+          if (a != k) face[n++] = v[a];
+        if (triple(m_, v[k], face[0], face[1], face[2]) < 0) std::swap(face[1], face[2]);
+        faces.emplace(key, face);
+      }
+    return faces;
+  }
+
+  /// The worst tet_quality of the star of x over `faces` (x appended as vertex p while it is
+  /// measured), or -1 if a tetrahedron of it is inverted.
+  double star_quality(const Vec3& x, int p, const std::map<std::array<int, 3>, std::array<int, 3>>& faces) {
+    m_.coords.insert(m_.coords.end(), x.begin(), x.end());
+    double q = 1.0;
+    for (const auto& [key, f] : faces) {
+      if (triple(m_, p, f[0], f[1], f[2]) <= 0) {
+        q = -1;
+        break;
+      }
+      q = std::min(q, tet_quality(m_, {p, f[0], f[1], f[2]}));
+    }
+    m_.coords.resize(m_.coords.size() - 3);
+    return q;
+  }
+
+  /// Tries to insert a new vertex near sliver c (Bowyer-Watson: the cavity of the point is
+  /// replaced by its star); true if it did. The best candidate (insertion_candidates) whose
+  /// star is valid must beat the worst tetrahedron it replaces.
+  bool insert_vertex(int c) {
+    const std::vector<Vec3> candidates = insertion_candidates(c);
     const int p = int(m_.n_vertices());
     double best_gain = 1e-9;
     std::vector<int> best_cavity;
     std::vector<std::array<int, 3>> best_faces;
     int best = -1;
     for (std::size_t i = 0; i < candidates.size(); ++i) {
-      // The cavity.
-      std::vector<int> cavity{c}, todo{c};
-      std::set<int> in_cavity{c};
-      while (!todo.empty()) {
-        const int t = todo.back();
-        todo.pop_back();
-        for (int skip = 0; skip < 4; ++skip) {
-          const auto f = sorted_face(tets_[t], skip);
-          if (boundary_faces_.contains(f)) continue;
-          const int u = neighbour(t, f);
-          if (u < 0 || in_cavity.contains(u) || !in_circumsphere(tets_[u], candidates[i])) continue;
-          in_cavity.insert(u);
-          cavity.push_back(u);
-          todo.push_back(u);
-        }
-      }
-      // Its faces, oriented with the cavity on their positive side.
-      std::map<std::array<int, 3>, std::array<int, 3>> faces;
-      for (int t : cavity)
-        for (int k = 0; k < 4; ++k) {
-          const auto key = sorted_face(tets_[t], k);
-          if (faces.erase(key)) continue;  // shared by two cavity tetrahedra
-          const Tet& v = tets_[t];
-          std::array<int, 3> face{};
-          int n = 0;
-          for (int a = 0; a < 4; ++a)
-            if (a != k) face[n++] = v[a];
-          if (triple(m_, v[k], face[0], face[1], face[2]) < 0) std::swap(face[1], face[2]);
-          faces.emplace(key, face);
-        }
+      const std::vector<int> cavity = cavity_of(c, candidates[i]);
+      const auto faces = cavity_faces(cavity);
       double old_quality = 1.0;
       for (int t : cavity) old_quality = std::min(old_quality, tet_quality(m_, tets_[t]));
-      m_.coords.insert(m_.coords.end(), candidates[i].begin(), candidates[i].end());
-      double q = 1.0;
-      for (const auto& [key, f] : faces) {
-        if (triple(m_, p, f[0], f[1], f[2]) <= 0) {
-          q = -1;
-          break;
-        }
-        q = std::min(q, tet_quality(m_, {p, f[0], f[1], f[2]}));
-      }
-      m_.coords.resize(m_.coords.size() - 3);
+      const double q = star_quality(candidates[i], p, faces);
       if (q - old_quality > best_gain) {
         best_gain = q - old_quality;
         best = int(i);

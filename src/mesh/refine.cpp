@@ -23,6 +23,31 @@ double orientation(int d, const std::array<std::array<double, 3>, 4>& x) {
 /// edges in the order of `pair` below.
 using Child = std::array<int, 4>;
 
+/// The children of a cell whose local nodes (vertices, then edge midpoints) are at x. 2D: m01 =
+/// 3, m12 = 4, m02 = 5. 3D: m01 = 4, m12 = 5, m02 = 6, m03 = 7, m13 = 8, m23 = 9; the four
+/// corner tetrahedra and the octahedron m01 m12 m02 m03 m13 m23 cut along its shortest diagonal
+/// (the best-shaped inner tetrahedra), the four tetrahedra around it.
+std::vector<Child> children_of(int d, const std::array<std::array<double, 3>, 10>& x) {
+  static const std::vector<Child> c2{{0, 3, 5, 0}, {3, 1, 4, 0}, {5, 4, 2, 0}, {3, 4, 5, 0}};
+  static const std::vector<Child> corners3{{0, 4, 6, 7}, {4, 1, 5, 8}, {6, 5, 2, 9}, {7, 8, 9, 3}};
+  // The three diagonals (m01-m23, m12-m03, m02-m13), each with the ring around it.
+  static const std::array<std::array<int, 6>, 3> diagonals{{{4, 9, 5, 6, 7, 8},    // m01-m23; ring m12 m02 m03 m13
+                                                            {5, 7, 4, 6, 9, 8},    // m12-m03; ring m01 m02 m23 m13
+                                                            {6, 8, 4, 5, 9, 7}}};  // m02-m13; ring m01 m12 m23 m03
+  if (d == 2) return c2;
+  std::vector<Child> children = corners3;
+  double best = 1e300;
+  std::size_t pick = 0;
+  for (std::size_t i = 0; i < diagonals.size(); ++i) {
+    double l2 = 0;
+    for (int k = 0; k < 3; ++k) l2 += std::pow(x[std::size_t(diagonals[i][0])][std::size_t(k)] - x[std::size_t(diagonals[i][1])][std::size_t(k)], 2);
+    if (l2 < best) best = l2, pick = i;
+  }
+  const auto& g = diagonals[pick];
+  for (int r = 0; r < 4; ++r) children.push_back({g[0], g[1], g[2 + r], g[2 + (r + 1) % 4]});
+  return children;
+}
+
 }  // namespace
 
 RefinedMesh refine_uniform(const MeshData& coarse) {
@@ -34,18 +59,10 @@ RefinedMesh refine_uniform(const MeshData& coarse) {
   out.mesh.dim = d;
   out.mesh.coords = coarse.coords;
   out.coarse_cells = coarse.cells;
-  // Local edges (a, b) and the children in local node numbers (vertices 0..d, midpoints d+1..).
+  // Local edges (a, b) in local node numbers (vertices 0..d, midpoints d+1..).
   static const std::vector<std::pair<int, int>> e2{{0, 1}, {1, 2}, {0, 2}};
   static const std::vector<std::pair<int, int>> e3{{0, 1}, {1, 2}, {0, 2}, {0, 3}, {1, 3}, {2, 3}};
   const auto& pair = d == 2 ? e2 : e3;
-  // 2D: m01 = 3, m12 = 4, m02 = 5. 3D: m01 = 4, m12 = 5, m02 = 6, m03 = 7, m13 = 8, m23 = 9.
-  static const std::vector<Child> c2{{0, 3, 5, 0}, {3, 1, 4, 0}, {5, 4, 2, 0}, {3, 4, 5, 0}};
-  static const std::vector<Child> corners3{{0, 4, 6, 7}, {4, 1, 5, 8}, {6, 5, 2, 9}, {7, 8, 9, 3}};
-  // The octahedron m01 m12 m02 m03 m13 m23: three diagonals (m01-m23, m12-m03, m02-m13), each with
-  // the four tetrahedra around it.
-  static const std::array<std::array<int, 6>, 3> diagonals{{{4, 9, 5, 6, 7, 8},    // m01-m23; ring m12 m02 m03 m13
-                                                            {5, 7, 4, 6, 9, 8},    // m12-m03; ring m01 m02 m23 m13
-                                                            {6, 8, 4, 5, 9, 7}}};  // m02-m13; ring m01 m12 m23 m03
   std::map<std::pair<int, int>, int> midpoint;
   auto mid = [&](int a, int b) {
     const auto key = std::minmax(a, b);
@@ -72,18 +89,7 @@ RefinedMesh refine_uniform(const MeshData& coarse) {
     }
     for (int a = 0; a < nv + int(pair.size()); ++a)
       for (int k = 0; k < d; ++k) x[std::size_t(a)][std::size_t(k)] = out.mesh.coords[std::size_t(node[a] * d + k)];
-    std::vector<Child> children = d == 2 ? c2 : corners3;
-    if (d == 3) {  // the shortest diagonal gives the best-shaped inner tetrahedra
-      double best = 1e300;
-      std::size_t pick = 0;
-      for (std::size_t i = 0; i < diagonals.size(); ++i) {
-        double l2 = 0;
-        for (int k = 0; k < 3; ++k) l2 += std::pow(x[std::size_t(diagonals[i][0])][std::size_t(k)] - x[std::size_t(diagonals[i][1])][std::size_t(k)], 2);
-        if (l2 < best) best = l2, pick = i;
-      }
-      const auto& g = diagonals[pick];
-      for (int r = 0; r < 4; ++r) children.push_back({g[0], g[1], g[2 + r], g[2 + (r + 1) % 4]});
-    }
+    const std::vector<Child> children = children_of(d, x);
     std::array<std::array<double, 3>, 4> px{};
     for (int a = 0; a < nv; ++a) px[std::size_t(a)] = x[std::size_t(a)];
     const bool positive = orientation(d, px) > 0;

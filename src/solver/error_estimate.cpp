@@ -315,6 +315,35 @@ double max_node(const std::vector<double>& v, int d, std::size_t* at = nullptr) 
   return std::sqrt(std::max(m, 0.0));
 }
 
+/// The estimates on rank 0 from canonical arrays: u_h (uc) and P u_h (pu), the fine step e (ev)
+/// and du/dalpha (av): {rel L2, raw rel L2, max, raw max, slope, ok}.
+std::array<double, 6> estimate_values(const Space& fs, const std::vector<double>& pu, const std::vector<double>& uc,
+                                      const std::vector<double>& ev, const std::vector<double>& av, double theta,
+                                      double alpha) {
+  const int d = fs.dim(), p = fs.degree();
+  std::array<double, 6> vals{};
+  std::vector<double> uf(pu.size()), uf1(pu.size()), te(ev.size());
+  for (std::size_t i = 0; i < pu.size(); ++i)
+    te[i] = theta * ev[i], uf[i] = pu[i] + te[i], uf1[i] = pu[i] + ev[i];
+  const auto& x = fs.canonical_coords();
+  const auto& cells = fs.canonical_cells();
+  const double ee = l2_norm_squared(d, p, x, cells, ev, d);
+  const double mp = max_node(pu, d);
+  vals[0] = std::sqrt(theta * theta * ee / l2_norm_squared(d, p, x, cells, uf, d));
+  vals[1] = std::sqrt(ee / l2_norm_squared(d, p, x, cells, uf1, d));
+  vals[2] = mp > 0 ? (max_node(uf, d) - mp) / mp : 0;
+  vals[3] = mp > 0 ? (max_node(uf1, d) - mp) / mp : 0;
+  // dmax/dalpha at the node of max |u_h|: (u_k / |u_k|) . a_k.
+  std::size_t km = 0;
+  const double mh = max_node(uc, d, &km);
+  double slope = 0;
+  for (int k = 0; k < d && mh > 0; ++k) slope += uc[km * std::size_t(d) + std::size_t(k)] / mh * av[km * std::size_t(d) + std::size_t(k)];
+  if (!(slope > 0) || !std::isfinite(slope)) slope = alpha != 0 ? mh / alpha : 0;  // the secant
+  vals[4] = slope;
+  vals[5] = finite_all({vals[0], vals[1], vals[2], vals[3], vals[4]}) ? 1 : 0;
+  return vals;
+}
+
 }  // namespace
 
 double TwoLevelEstimator::energy_search(Vec x, Vec dx, double alpha, Vec w, ErrorEstimate& out) const {
@@ -332,15 +361,54 @@ double TwoLevelEstimator::energy_search(Vec x, Vec dx, double alpha, Vec w, Erro
   return accepted;
 }
 
+namespace {
+
+/// f() timed into acc; its result.
+template <class F>
+bool timed(double& acc, F&& f) {
+  const double t = MPI_Wtime();
+  const bool ok = f();
+  acc += MPI_Wtime() - t;
+  return ok;
+}
+
+}  // namespace
+
+double TwoLevelEstimator::fine_step(Vec x, Vec r, double alpha, bool first, bool& fell_back, ErrorEstimate& out) const {
+  Vec dx = fv_[2], w = fv_[3];
+  out.tangent_assemblies += 1;
+  if (!timed(out.seconds_assembly, [&] { return fine_.jacobian(x, Kf_); })) return -1;
+  HS_PETSC(KSPSetOperators(ksp_, Kf_, Kf_));
+  HS_PETSC(VecScale(r, -1.0));
+  timed(out.seconds_linear, [&] {
+    HS_PETSC(KSPSolve(ksp_, r, dx));
+    return true;
+  });
+  KSPConvergedReason reason;
+  PetscInt its;
+  HS_PETSC(KSPGetConvergedReason(ksp_, &reason));
+  HS_PETSC(KSPGetIterationNumber(ksp_, &its));
+  out.krylov_iterations += int(its);
+  if (reason <= 0) return -1;
+  double lambda = energy_search(x, dx, alpha, w, out);
+  fell_back = false;
+  if (lambda == 0 && first) {
+    // No descent along the Newton step of an indefinite fine tangent (two Random2D load cases
+    // of 44 once the step was solved to its tolerance): the two-grid preconditioner's own
+    // step (a symmetric cycle on the coarse factor) instead, and Newton on from there (that
+    // step alone gave half the u_{h/2} - u_h of a Random3D case).
+    PC pc;
+    HS_PETSC(KSPGetPC(ksp_, &pc));
+    HS_PETSC(PCApply(pc, r, dx));
+    lambda = energy_search(x, dx, alpha, w, out);
+    fell_back = true;
+  }
+  return lambda;
+}
+
 bool TwoLevelEstimator::fine_newton(Vec Pu, double alpha, Vec e, ErrorEstimate& out) const {
-  Vec x = fv_[0], r = fv_[1], dx = fv_[2], w = fv_[3], g = fv_[4];
+  Vec x = fv_[0], r = fv_[1], w = fv_[3], g = fv_[4];
   HS_PETSC(VecCopy(Pu, x));
-  auto timed = [](double& acc, auto&& f) {
-    const double t = MPI_Wtime();
-    const bool ok = f();
-    acc += MPI_Wtime() - t;
-    return ok;
-  };
   out.residual_assemblies += 1;
   if (!timed(out.seconds_assembly, [&] { return fine_.residual(x, alpha, r); })) return false;
   PetscReal r0, rn, gn = 0;
@@ -352,33 +420,9 @@ bool TwoLevelEstimator::fine_newton(Vec Pu, double alpha, Vec e, ErrorEstimate& 
   // Random2D load case).
   bool full_step = true;
   for (int it = 0; it < 4 && (it == 0 || !full_step) && rn > 1e-2 * r0; ++it) {
-    out.tangent_assemblies += 1;
-    if (!timed(out.seconds_assembly, [&] { return fine_.jacobian(x, Kf_); })) return false;
-    HS_PETSC(KSPSetOperators(ksp_, Kf_, Kf_));
-    HS_PETSC(VecScale(r, -1.0));
-    timed(out.seconds_linear, [&] {
-      HS_PETSC(KSPSolve(ksp_, r, dx));
-      return true;
-    });
-    KSPConvergedReason reason;
-    PetscInt its;
-    HS_PETSC(KSPGetConvergedReason(ksp_, &reason));
-    HS_PETSC(KSPGetIterationNumber(ksp_, &its));
-    out.krylov_iterations += int(its);
-    if (reason <= 0) return false;
-    double lambda = energy_search(x, dx, alpha, w, out);
     bool fell_back = false;
-    if (lambda == 0 && it == 0) {
-      // No descent along the Newton step of an indefinite fine tangent (two Random2D load cases
-      // of 44 once the step was solved to its tolerance): the two-grid preconditioner's own
-      // step (a symmetric cycle on the coarse factor) instead, and Newton on from there (that
-      // step alone gave half the u_{h/2} - u_h of a Random3D case).
-      PC pc;
-      HS_PETSC(KSPGetPC(ksp_, &pc));
-      HS_PETSC(PCApply(pc, r, dx));
-      lambda = energy_search(x, dx, alpha, w, out);
-      fell_back = true;
-    }
+    const double lambda = fine_step(x, r, alpha, it == 0, fell_back, out);
+    if (lambda < 0) return false;
     const bool accepted = lambda > 0;
     full_step = full_step && lambda == 1.0 && !fell_back;
     // No descent after an accepted (cut) step: keep that state (flagged: not converged). With
@@ -452,7 +496,7 @@ ErrorEstimate TwoLevelEstimator::estimate(Vec u_h, double alpha, const CoarseSol
   ErrorEstimate out;
   const double t0 = MPI_Wtime();
   const Space& fs = fine_.space();
-  const int d = fs.dim(), p = fs.degree();
+  const int d = fs.dim();
   const MPI_Comm comm = fs.comm();
   PetscReal order = 1.0;
   PetscOptionsGetReal(nullptr, nullptr, "-error_estimate_order", &order, nullptr);
@@ -474,30 +518,9 @@ ErrorEstimate TwoLevelEstimator::estimate(Vec u_h, double alpha, const CoarseSol
   ok = ok && !coarse_failed_;
   coarse_solve_ = nullptr;
   const std::vector<double> uc = coarse_.gather(u_h).values, ev = fine_.gather(e).values, av = coarse_.gather(a).values;
-  double vals[6] = {0, 0, 0, 0, 0, 0};  // rel L2, raw rel L2, max, raw max, slope, ok
-  if (core::rank(comm) == 0 && ok) {
-    const std::vector<double> pu = prolong(uc);
-    std::vector<double> uf(pu.size()), uf1(pu.size()), te(ev.size());
-    for (std::size_t i = 0; i < pu.size(); ++i)
-      te[i] = theta * ev[i], uf[i] = pu[i] + te[i], uf1[i] = pu[i] + ev[i];
-    const auto& x = fs.canonical_coords();
-    const auto& cells = fs.canonical_cells();
-    const double ee = l2_norm_squared(d, p, x, cells, ev, d);
-    const double mp = max_node(pu, d);
-    vals[0] = std::sqrt(theta * theta * ee / l2_norm_squared(d, p, x, cells, uf, d));
-    vals[1] = std::sqrt(ee / l2_norm_squared(d, p, x, cells, uf1, d));
-    vals[2] = mp > 0 ? (max_node(uf, d) - mp) / mp : 0;
-    vals[3] = mp > 0 ? (max_node(uf1, d) - mp) / mp : 0;
-    // dmax/dalpha at the node of max |u_h|: (u_k / |u_k|) . a_k.
-    std::size_t km = 0;
-    const double mh = max_node(uc, d, &km);
-    double slope = 0;
-    for (int k = 0; k < d && mh > 0; ++k) slope += uc[km * std::size_t(d) + std::size_t(k)] / mh * av[km * std::size_t(d) + std::size_t(k)];
-    if (!(slope > 0) || !std::isfinite(slope)) slope = alpha != 0 ? mh / alpha : 0;  // the secant
-    vals[4] = slope;
-    vals[5] = finite_all({vals[0], vals[1], vals[2], vals[3], vals[4]}) ? 1 : 0;
-  }
-  MPI_Bcast(vals, 6, MPI_DOUBLE, 0, comm);
+  std::array<double, 6> vals{};  // rel L2, raw rel L2, max, raw max, slope, ok
+  if (core::rank(comm) == 0 && ok) vals = estimate_values(fs, prolong(uc), uc, ev, av, theta, alpha);
+  MPI_Bcast(vals.data(), 6, MPI_DOUBLE, 0, comm);
   out.ok = vals[5] > 0.5;
   if (out.ok) {
     out.rel_l2 = vals[0], out.raw_rel_l2 = vals[1], out.max_u = vals[2], out.raw_max_u = vals[3];
