@@ -234,18 +234,22 @@ std::vector<double> circle_crossings(const RandomDeformation& phi, const CurveSa
   return out;
 }
 
-Boundary resolve_curve(const RandomDeformation& phi, const CurveSamples& curve,
-                       std::span<const double> local_size, std::span<const double> forced) {
+namespace {
+
+/// A candidate vertex of the resolved curve: its parameter, position, the local size of the
+/// nearest sample, and whether it must be kept (a forced parameter).
+struct CurveCandidate {
+  double theta;
+  double x, y, size;
+  bool keep;
+};
+
+/// Candidate vertices in parameter order: the samples and the forced parameters (a sample that
+/// coincides with a forced point is dropped in favour of the forced one).
+std::vector<CurveCandidate> curve_candidates(const RandomDeformation& phi, const CurveSamples& curve,
+                                             std::span<const double> local_size, std::span<const double> forced) {
   const std::size_t n = curve.size();
-  assert(local_size.size() == n);
-  // Candidate vertices in parameter order: samples and forced parameters (forced ones must be
-  // kept). Each candidate carries the local size of the nearest sample.
-  struct Candidate {
-    double theta;
-    double x, y, size;
-    bool keep;
-  };
-  std::vector<Candidate> cand;
+  std::vector<CurveCandidate> cand;
   cand.reserve(n + forced.size());
   std::vector<double> f(forced.begin(), forced.end());
   std::sort(f.begin(), f.end());
@@ -254,7 +258,6 @@ Boundary resolve_curve(const RandomDeformation& phi, const CurveSamples& curve,
     while (k < f.size() && f[k] <= curve.theta[i]) {
       const auto p = circle_image(phi, f[k], true);
       const double s = std::min(local_size[i], local_size[(i + n - 1) % n]);
-      // A sample that coincides with a forced point is dropped in favour of the forced one.
       if (!cand.empty() && cand.back().theta == f[k]) cand.pop_back();
       cand.push_back({f[k], p[0], p[1], s, true});
       ++k;
@@ -266,6 +269,15 @@ Boundary resolve_curve(const RandomDeformation& phi, const CurveSamples& curve,
     const auto p = circle_image(phi, f[k], true);
     cand.push_back({f[k], p[0], p[1], std::min(local_size[n - 1], local_size[0]), true});
   }
+  return cand;
+}
+
+}  // namespace
+
+Boundary resolve_curve(const RandomDeformation& phi, const CurveSamples& curve,
+                       std::span<const double> local_size, std::span<const double> forced) {
+  assert(local_size.size() == curve.size());
+  const std::vector<CurveCandidate> cand = curve_candidates(phi, curve, local_size, forced);
   const std::size_t m = cand.size();
   // Start at a kept candidate if there is one, so the walk never skips it.
   std::size_t start = 0;

@@ -379,11 +379,11 @@ std::vector<std::array<int, 3>> boundary_facets(const MeshData& m) {
   return once;
 }
 
-/// Reads the simplices of the current model into MeshData: boundary points first (matched by
-/// their exact coordinates, written from the input), then the interior vertices in order of
-/// first use; cells oriented for PETSc.
-MeshData collect(const Boundary& b) {
-  const int dim = b.dim, nv = dim + 1;
+/// The gmsh nodes of the current model (xyz: 3 per node) mapped to output indices: a boundary
+/// point of b (matched by its exact coordinates) or -1 - its position in node_tags (interior).
+std::unordered_map<std::size_t, int> node_index(const Boundary& b, const std::vector<std::size_t>& node_tags,
+                                                const std::vector<double>& xyz) {
+  const int dim = b.dim;
   const std::int64_t n_bnd = b.n_points();
   std::map<std::array<double, 3>, int> boundary_index;
   for (std::int64_t i = 0; i < n_bnd; ++i) {
@@ -391,11 +391,6 @@ MeshData collect(const Boundary& b) {
     for (int k = 0; k < dim; ++k) key[k] = b.points[std::size_t(i * dim + k)];
     boundary_index.emplace(key, int(i));
   }
-
-  std::vector<std::size_t> node_tags;
-  std::vector<double> xyz, param;
-  gmsh::model::mesh::getNodes(node_tags, xyz, param, -1, -1, false, false);
-  // gmsh node tag -> output index (boundary) or -1 - position in node_tags (interior).
   std::unordered_map<std::size_t, int> index;
   index.reserve(node_tags.size());
   std::vector<char> matched(std::size_t(n_bnd), 0);
@@ -413,6 +408,18 @@ MeshData collect(const Boundary& b) {
   }
   if (std::count(matched.begin(), matched.end(), 0) > 0)
     mesh_failed("a boundary point is not a node of the mesh");
+  return index;
+}
+
+/// Reads the simplices of the current model into MeshData: boundary points first (matched by
+/// their exact coordinates, written from the input), then the interior vertices in order of
+/// first use; cells oriented for PETSc.
+MeshData collect(const Boundary& b) {
+  const int dim = b.dim, nv = dim + 1;
+  std::vector<std::size_t> node_tags;
+  std::vector<double> xyz, param;
+  gmsh::model::mesh::getNodes(node_tags, xyz, param, -1, -1, false, false);
+  const std::unordered_map<std::size_t, int> index = node_index(b, node_tags, xyz);
 
   std::vector<std::size_t> elem_tags, elem_nodes;
   gmsh::model::mesh::getElementsByType(dim == 2 ? 2 : 4, elem_tags, elem_nodes, -1);
@@ -444,7 +451,6 @@ MeshData collect(const Boundary& b) {
     // PETSc: triangles counter-clockwise, tetrahedra with negative triple product.
     if (dim == 2 ? s < 0 : s > 0) std::swap(cell[1], cell[2]);
   }
-
   return m;
 }
 

@@ -159,12 +159,35 @@ class CellBuckets {
   CellBuckets(int dim, std::span<const double> nodes, std::span<const std::int64_t> cells, int npc,
               const CellMaps& maps)
       : dim_(dim) {
-    const std::size_t d = std::size_t(dim), n_cells = cells.size() / std::size_t(npc);
-    std::vector<double> boxes(n_cells * 2 * d);  // per cell: min (d), max (d)
+    const std::size_t n_cells = cells.size() / std::size_t(npc);
     double mean_extent = 0;
     std::size_t n_valid = 0;
+    const std::vector<double> boxes = cell_boxes(nodes, cells, npc, maps, mean_extent, n_valid);
+    set_grid(mean_extent, n_valid);
+    fill(boxes, n_cells, maps);
+  }
+
+  /// The cells listed in x's bucket (empty outside the bounding box).
+  std::span<const std::int32_t> candidates(const double* x) const {
+    std::array<int, 3> i{0, 0, 0};
+    for (std::size_t k = 0; k < std::size_t(dim_); ++k) {
+      if (!(x[k] >= lo_[k] && x[k] <= hi_[k])) return {};
+      i[k] = index(x[k], k);
+    }
+    const std::size_t b = flat(i[0], i[1], i[2]);
+    return {items_.data() + start_[b], std::size_t(start_[b + 1] - start_[b])};
+  }
+
+ private:
+  /// Per cell its bounding box (min (d), max (d)), enlarged so that points with barycentric
+  /// coordinates down to -kNear are found; lo_/hi_ their union; the mean extent and number of
+  /// the valid cells.
+  std::vector<double> cell_boxes(std::span<const double> nodes, std::span<const std::int64_t> cells, int npc,
+                                 const CellMaps& maps, double& mean_extent, std::size_t& n_valid) {
+    const std::size_t d = std::size_t(dim_), n_cells = cells.size() / std::size_t(npc);
+    std::vector<double> boxes(n_cells * 2 * d);
     lo_.fill(HUGE_VAL);
-    std::array<double, 3> hi{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    hi_.fill(-HUGE_VAL);
     for (std::size_t c = 0; c < n_cells; ++c) {
       double* b = boxes.data() + c * 2 * d;
       for (std::size_t k = 0; k < d; ++k) b[k] = HUGE_VAL, b[d + k] = -HUGE_VAL;
@@ -175,35 +198,43 @@ class CellBuckets {
       }
       double extent = 0;
       for (std::size_t k = 0; k < d; ++k) extent = std::max(extent, b[d + k] - b[k]);
-      // Enlarged so that points with barycentric coordinates down to -kNear are found.
       for (std::size_t k = 0; k < d; ++k)
         b[k] -= 2 * kNear * extent, b[d + k] += 2 * kNear * extent;
       for (std::size_t k = 0; k < d; ++k)
-        lo_[k] = std::min(lo_[k], b[k]), hi[k] = std::max(hi[k], b[d + k]);
+        lo_[k] = std::min(lo_[k], b[k]), hi_[k] = std::max(hi_[k], b[d + k]);
       if (maps.valid(c)) mean_extent += extent, ++n_valid;
     }
     mean_extent = n_valid ? mean_extent / double(n_valid) : 1.0;
-    // Buckets of about the mean cell size (a few cells each), at most ~4 per cell.
+    return boxes;
+  }
+
+  /// Buckets of about the mean cell size (a few cells each), at most ~4 per cell.
+  void set_grid(double mean_extent, std::size_t n_valid) {
+    const std::size_t d = std::size_t(dim_);
     double h = mean_extent > 0 ? mean_extent : 1.0;
     for (;;) {
       double total = 1;
-      for (std::size_t k = 0; k < d; ++k) total *= std::max(1.0, std::ceil((hi[k] - lo_[k]) / h));
+      for (std::size_t k = 0; k < d; ++k) total *= std::max(1.0, std::ceil((hi_[k] - lo_[k]) / h));
       if (total <= 4.0 * double(std::max<std::size_t>(n_valid, 1)) + 64) break;
       h *= 1.25;
     }
-    std::size_t n_buckets = 1;
     for (std::size_t k = 0; k < d; ++k) {
-      n_[k] = int(std::max(1.0, std::ceil((hi[k] - lo_[k]) / h)));
+      n_[k] = int(std::max(1.0, std::ceil((hi_[k] - lo_[k]) / h)));
       inv_h_[k] = 1.0 / h;
-      n_buckets *= std::size_t(n_[k]);
     }
+  }
+
+  /// Lists every valid cell in each bucket its box meets (counted, then filled: CSR).
+  void fill(const std::vector<double>& boxes, std::size_t n_cells, const CellMaps& maps) {
+    const std::size_t d = std::size_t(dim_);
+    const std::size_t n_buckets = std::size_t(n_[0]) * std::size_t(n_[1]) * std::size_t(n_[2]);
     start_.assign(n_buckets + 1, 0);
     for (int pass = 0; pass < 2; ++pass) {
-      std::vector<std::int64_t> fill;
+      std::vector<std::int64_t> next;
       if (pass == 1) {
         for (std::size_t b = 0; b < n_buckets; ++b) start_[b + 1] += start_[b];
         items_.resize(std::size_t(start_.back()));
-        fill.assign(start_.begin(), start_.end() - 1);
+        next.assign(start_.begin(), start_.end() - 1);
       }
       for (std::size_t c = 0; c < n_cells; ++c) {
         if (!maps.valid(c)) continue;
@@ -220,25 +251,12 @@ class CellBuckets {
               if (pass == 0)
                 ++start_[bucket + 1];
               else
-                items_[std::size_t(fill[bucket]++)] = std::int32_t(c);
+                items_[std::size_t(next[bucket]++)] = std::int32_t(c);
             }
       }
     }
-    for (std::size_t k = 0; k < d; ++k) hi_[k] = hi[k];
   }
 
-  /// The cells listed in x's bucket (empty outside the bounding box).
-  std::span<const std::int32_t> candidates(const double* x) const {
-    std::array<int, 3> i{0, 0, 0};
-    for (std::size_t k = 0; k < std::size_t(dim_); ++k) {
-      if (!(x[k] >= lo_[k] && x[k] <= hi_[k])) return {};
-      i[k] = index(x[k], k);
-    }
-    const std::size_t b = flat(i[0], i[1], i[2]);
-    return {items_.data() + start_[b], std::size_t(start_[b + 1] - start_[b])};
-  }
-
- private:
   int index(double x, std::size_t k) const {
     const double s = std::floor((x - lo_[k]) * inv_h_[k]);
     return int(std::clamp(s, 0.0, double(n_[k] - 1)));
@@ -268,6 +286,27 @@ void sort_key(std::array<std::int64_t, 3>& k, int n) {
   }
 }
 
+using FaceKey = std::array<std::int64_t, 3>;
+
+/// Sorted vertex triples (third -1 in 2D) -> facet, sorted, for matching cell faces; which
+/// points are facet vertices.
+std::vector<std::pair<FaceKey, std::int64_t>> facet_keys(int dim, const geometry::Boundary& boundary,
+                                                         std::vector<std::uint8_t>& on_boundary) {
+  const std::int64_t n_facets = boundary.n_facets();
+  std::vector<std::pair<FaceKey, std::int64_t>> keys;
+  keys.reserve(std::size_t(n_facets));
+  on_boundary.assign(std::size_t(boundary.n_points()), 0);
+  for (std::int64_t f = 0; f < n_facets; ++f) {
+    const auto v = boundary.facet(f);
+    FaceKey k{v[0], v[1], dim == 3 ? v[2] : -1};
+    sort_key(k, dim);
+    keys.push_back({k, f});
+    for (const int p : v) on_boundary[std::size_t(p)] = 1;
+  }
+  std::sort(keys.begin(), keys.end());
+  return keys;
+}
+
 /// The stencil nodes of every boundary facet: its vertices (in the Boundary's order) and, for
 /// P2, the midpoints of its edges (a b, b c, c a), read off the cell the facet belongs to.
 /// Throws if a facet is not a face of any cell.
@@ -278,19 +317,9 @@ std::vector<std::int32_t> facet_nodes(int dim, int degree, std::span<const std::
   const int fw = degree == 1 ? dim : (dim == 2 ? 3 : 6);
   std::vector<std::int32_t> out(std::size_t(n_facets) * std::size_t(fw), -1);
 
-  // Sorted vertex triples (third -1 in 2D) -> facet, for matching cell faces.
-  using Key = std::array<std::int64_t, 3>;
-  std::vector<std::pair<Key, std::int64_t>> keys;
-  keys.reserve(std::size_t(n_facets));
-  std::vector<std::uint8_t> on_boundary(std::size_t(boundary.n_points()), 0);
-  for (std::int64_t f = 0; f < n_facets; ++f) {
-    const auto v = boundary.facet(f);
-    Key k{v[0], v[1], dim == 3 ? v[2] : -1};
-    sort_key(k, dim);
-    keys.push_back({k, f});
-    for (const int p : v) on_boundary[std::size_t(p)] = 1;
-  }
-  std::sort(keys.begin(), keys.end());
+  std::vector<std::uint8_t> on_boundary;
+  const std::vector<std::pair<FaceKey, std::int64_t>> keys = facet_keys(dim, boundary, on_boundary);
+  using Key = FaceKey;
   std::vector<std::uint8_t> found(std::size_t(n_facets), 0);
 
   const std::size_t n_cells = cells.size() / std::size_t(npc);

@@ -130,38 +130,37 @@ bool lowest_ritz_pair(const Small& G, const Small& B, int n, double& value, Eige
 
 }  // namespace
 
-EigenEstimate smallest_eigenvalue(Mat A, PC pc, Vec x, double rtol, int max_iterations) {
+namespace {
+
+/// Block-size-1 LOBPCG's state: the iterate x, the preconditioned residual w, the previous
+/// direction p, and their products with A.
+struct Lobpcg {
+  Mat A;
+  Vec x;
   core::VecH Ax, r, w, Aw, p, Ap, t, At;
-  for (core::VecH* v : {&Ax, &r, &w, &Aw, &p, &Ap, &t, &At}) HS_PETSC(VecDuplicate(x, v->out()));
-  PetscReal nrm, lam;
-  HS_PETSC(VecNormalize(x, &nrm));
-  HS_PETSC(MatMult(A, x, Ax));
-  HS_PETSC(VecDot(x, Ax, &lam));
-  EigenEstimate e;
   bool have_p = false;
-  std::vector<double> history;
-  for (int k = 0;; ++k) {
-    HS_PETSC(VecWAXPY(r, -lam, x, Ax));
-    PetscReal rn;
-    HS_PETSC(VecNorm(r, NORM_2, &rn));
-    e.value = lam, e.residual = rn, e.iterations = k;
-    if (!std::isfinite(lam) || !std::isfinite(rn)) return e;
-    // The sign is settled by a negative Rayleigh quotient (an upper bound of the smallest
-    // eigenvalue), by a small residual, or by a quotient that has stopped falling: 1% over 10
-    // iterations (the residual of a near-double eigenvalue, e.g. the ball's two bending modes,
-    // converges far more slowly than the quotient: measured 70 against 40 iterations).
-    history.push_back(lam);
-    const bool stalled = k >= 10 && history[std::size_t(k - 10)] - lam <= 0.01 * lam;
-    if (lam < 0 || rn <= rtol * lam || stalled) {
-      e.settled = true;
-      return e;
-    }
-    if (k == max_iterations) return e;
+
+  Lobpcg(Mat A_, Vec x_) : A(A_), x(x_) {
+    for (core::VecH* v : {&Ax, &r, &w, &Aw, &p, &Ap, &t, &At}) HS_PETSC(VecDuplicate(x, v->out()));
+  }
+
+  /// Normalises x; its Rayleigh quotient.
+  double start() {
+    PetscReal nrm, lam;
+    HS_PETSC(VecNormalize(x, &nrm));
+    HS_PETSC(MatMult(A, x, Ax));
+    HS_PETSC(VecDot(x, Ax, &lam));
+    return lam;
+  }
+
+  /// One step: w = pc(r), Rayleigh-Ritz on span{x, w, p}; the new quotient, or false if the
+  /// step broke down.
+  bool step(PC pc, double& lam) {
+    PetscReal nrm;
     HS_PETSC(PCApply(pc, r, w));
     HS_PETSC(VecNormalize(w, &nrm));
-    if (!(nrm > 0) || !std::isfinite(nrm)) return e;
+    if (!(nrm > 0) || !std::isfinite(nrm)) return false;
     HS_PETSC(MatMult(A, w, Aw));
-    // Rayleigh-Ritz on span{x, w, p}.
     Vec S[3] = {x, w, p}, AS[3] = {Ax, Aw, Ap};
     Small G(3, 3), B(3, 3);
     for (int i = 0; i < 3; ++i)
@@ -175,7 +174,7 @@ EigenEstimate smallest_eigenvalue(Mat A, PC pc, Vec x, double rtol, int max_iter
     Eigen::VectorXd c;
     int n = have_p ? 3 : 2;
     if (!lowest_ritz_pair(G, B, n, value, c)) {
-      if (n == 2 || !lowest_ritz_pair(G, B, n = 2, value, c)) return e;
+      if (n == 2 || !lowest_ritz_pair(G, B, n = 2, value, c)) return false;
     }
     // p <- c1 w + c2 p, x <- c0 x + p (and their products with A alike).
     const double c2 = n == 3 ? c(2) : 0.0;
@@ -192,7 +191,37 @@ EigenEstimate smallest_eigenvalue(Mat A, PC pc, Vec x, double rtol, int max_iter
     HS_PETSC(VecNorm(x, NORM_2, &nrm));
     HS_PETSC(VecScale(x, 1.0 / nrm));
     HS_PETSC(VecScale(Ax, 1.0 / nrm));
-    HS_PETSC(VecDot(x, Ax, &lam));
+    PetscReal q;
+    HS_PETSC(VecDot(x, Ax, &q));
+    lam = q;
+    return true;
+  }
+};
+
+}  // namespace
+
+EigenEstimate smallest_eigenvalue(Mat A, PC pc, Vec x, double rtol, int max_iterations) {
+  Lobpcg it(A, x);
+  double lam = it.start();
+  EigenEstimate e;
+  std::vector<double> history;
+  for (int k = 0;; ++k) {
+    HS_PETSC(VecWAXPY(it.r, -lam, x, it.Ax));
+    PetscReal rn;
+    HS_PETSC(VecNorm(it.r, NORM_2, &rn));
+    e.value = lam, e.residual = rn, e.iterations = k;
+    if (!std::isfinite(lam) || !std::isfinite(rn)) return e;
+    // The sign is settled by a negative Rayleigh quotient (an upper bound of the smallest
+    // eigenvalue), by a small residual, or by a quotient that has stopped falling: 1% over 10
+    // iterations (the residual of a near-double eigenvalue, e.g. the ball's two bending modes,
+    // converges far more slowly than the quotient: measured 70 against 40 iterations).
+    history.push_back(lam);
+    const bool stalled = k >= 10 && history[std::size_t(k - 10)] - lam <= 0.01 * lam;
+    if (lam < 0 || rn <= rtol * lam || stalled) {
+      e.settled = true;
+      return e;
+    }
+    if (k == max_iterations || !it.step(pc, lam)) return e;
   }
 }
 
