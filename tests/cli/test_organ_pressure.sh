@@ -7,7 +7,8 @@
 #  - every load case converged; the channels are traction and pressure (docs/FORMAT.md): the
 #    pressure channel is the drawn p (params/pressure/value, in [0.3, 1.0]) at the Neumann nodes
 #    with z >= 0.2 and 0 at every other node, and on the grid p exactly at the points with
-#    z >= 0.2; the stored scene names the pressure.
+#    z >= 0.2; the stored scene names the pressure;
+#  - a box of 4 numbers (2D) on the 3D organ: exit code 2 before any work, the key named.
 # (The pressure's resultant on the organ surface: tests/physics/mpi_test_organ_pressure.cpp.)
 . "$(dirname "$0")/lib.sh"
 export PYTHONPATH="$src/scripts${PYTHONPATH:+:$PYTHONPATH}"
@@ -52,4 +53,11 @@ with h5py.File(sorted(__import__("glob").glob(sys.argv[1] + "/shards/*.h5"))[0],
     scene = f["scene"][()].decode() if isinstance(f["scene"][()], bytes) else str(f["scene"][()])
 assert "pressure" in scene and "box" in scene, scene
 PY
+
+# A 2D box on the 3D organ stops before any work, the key named.
+sed 's/box: \[-3, -3, 0.2, 3, 3, 3\]/box: [-3, 0.2, 3, 3]/' "$work/organ.yaml" > "$work/bad.yaml"
+out=$("$bin" -q generate "$work/bad.yaml" --progress 0 -o "$work/bad" 2>&1); code=$?
+if [ "$code" = 2 ] && [[ $out == *"effects.pressure.box: must be a list of 6 numbers"* ]] && [ ! -e "$work/bad" ]; then
+  ok "a 2D box on the organ: exit 2, effects.pressure.box named"
+else fail "bad box: exit $code, $out"; fi
 finish
