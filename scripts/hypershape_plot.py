@@ -9,7 +9,8 @@ the deformed mesh, P2 triangles split in four at their edge nodes; 3D: the bound
 of the deformed mesh in a Poly3DCollection, each coloured by the mean |u| of its corners and
 shaded by its normal), the undeformed outline (2D, dashed grey), the Dirichlet patch (red),
 each active Gaussian traction: its centre p_N (moved with the body) and its direction g (arrow),
-and the region of a `pressure` (white dots: the boundary vertices where its channel is not zero).
+and the region of a `pressure` (where its channel is not zero: white dots at the boundary
+vertices in 3D, a dotted black line in 2D).
 The title gives the shape, load case, achieved max|u|, target and alpha (or why it failed), and
 the pressure p drawn for the load case.
 """
