@@ -15,6 +15,13 @@
 #   pressure       + a fixed dead pressure 2 on the whole boundary
 #   mooney_rivlin  Mooney-Rivlin (C1 60, C2 24, kappa 8333: mu, K of E 500, nu 0.49) instead
 #   linear_elastic linear elasticity instead (one linear solve per load case: alpha exact)
+#   organ_pressure (3D presets only) + configs/examples/organ_pressure3d.yaml's pressure, fixed at
+#                  its middle value 0.65 on the facets at z >= 0.2
+# PRESET=aug_liver (or random3d, liver, one_liver) runs a 3D slice of that preset instead: its
+# patch radius 0.4 and gamma 0.1, targets [0.2, 0.5] (organ_pressure3d's) for every variant;
+# VARIANTS="paper spring" runs only those ("paper", the base of the ratios, always; in 3D the
+# default is "paper organ_pressure": gravity and the regions of the others are 2D values):
+#   PRESET=aug_liver VARIANTS="paper organ_pressure" scripts/bench_effects.sh 2 10 2
 # Prints JSON and a markdown table: the median seconds per load case (setup + solve + alpha
 # search + representations + gather, summed over the load cases) and its ratio to "paper"
 # measured in the same run (on a loaded host trust the ratio and the Newton iterations per
@@ -28,18 +35,22 @@ shapes=${1:-4} loads=${2:-10} repeats=${3:-2} previous=${4:-}
 export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-head="preset: random2d
+preset=${PRESET:-random2d}
+case $preset in random3d | aug_liver | liver | one_liver) dim=3 ;; *) dim=2 ;; esac
+if [ $dim = 3 ]; then : "${VARIANTS:=paper organ_pressure}"; fi  # the others' values are 2D ones
+head="preset: $preset
 name: bench_effects
 shapes: {count: $shapes}
-loads: {count: $loads}
+loads: {count: $loads$([ $dim = 3 ] && echo ", target: [0.2, 0.5]")}
 output: {shard_size: 2}"
 nh="  neo_hookean: {E: 500, nu: 0.49}"
-patch="  dirichlet_patch: {radius: 0.5}"
-traction="  gaussian_traction: {gamma: 0.2}"
+patch="  dirichlet_patch: {radius: $([ $dim = 3 ] && echo 0.4 || echo 0.5)}"
+traction="  gaussian_traction: {gamma: $([ $dim = 3 ] && echo 0.1 || echo 0.2)}"
 # variant name, then its effects (one line each; "" for the preset's shorthands).
 variant() {
   local name=$1
   shift
+  [[ $name == paper || -z ${VARIANTS:-} || " $VARIANTS " == *" $name "* ]] || return 0
   if [ $# -eq 0 ]; then printf '%s\n' "$head" > "$work/$name.yaml"
   else { printf '%s\neffects:\n' "$head"; printf '%s\n' "$@"; } > "$work/$name.yaml"; fi
   variants+=" $name"
@@ -57,6 +68,9 @@ variant supports3 "$nh" "$patch" "  dirichlet: [{box: [-3, -3, -0.85, 3]}, {cent
 variant pressure "$nh" "$patch" "$traction" "  pressure: {value: 2, scale: fixed}"
 variant mooney_rivlin "  mooney_rivlin: {C1: 60, C2: 24, kappa: 8333}" "$patch" "$traction"
 variant linear_elastic "  linear_elastic: {E: 500, nu: 0.49}" "$patch" "$traction"
+if [ $dim = 3 ]; then
+  variant organ_pressure "$nh" "$patch" "$traction" "  pressure: {value: 0.65, box: [-3, -3, 0.2, 3, 3, 3], scale: fixed}"
+fi
 for ((k = 0; k < repeats; ++k)); do
   for v in $variants; do build/hypershape -q generate "$work/$v.yaml" --progress 0 -o "$work/$v-$k"; done
   if [ -n "$previous" ]; then "$previous" -q generate "$work/paper.yaml" --progress 0 -o "$work/previous-$k"; fi
@@ -72,7 +86,8 @@ label = {"paper": "the preset (neo_hookean, dirichlet_patch, gaussian_traction)"
          "inclusions": "3 inclusions (r 0.25, 5x stiffer)", "grf": "log-normal GRF modulus (cv 0.3, length 0.3)",
          "supports3": "+ 2 fixed dirichlet regions (3 supports)", "pressure": "+ fixed dead pressure 2 (whole boundary)",
          "mooney_rivlin": "Mooney-Rivlin instead (C1 60, C2 24, kappa 8333: the same mu, K)",
-         "linear_elastic": "linear elasticity instead (one linear solve)"}
+         "linear_elastic": "linear elasticity instead (one linear solve)",
+         "organ_pressure": "+ fixed dead pressure 0.65 on the upper side (z >= 0.2; organ_pressure3d's)"}
 rows = {}
 for n in names:
     per_load, newton, conv = [], [], []

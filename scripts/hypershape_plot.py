@@ -7,15 +7,18 @@
 One panel per (shape, load case): the deformed body x + S u coloured by |u| (2D: tripcolor on
 the deformed mesh, P2 triangles split in four at their edge nodes; 3D: the boundary triangles
 of the deformed mesh in a Poly3DCollection, each coloured by the mean |u| of its corners and
-shaded by its normal), the undeformed outline (2D, dashed grey), the Dirichlet patch (red) and
-each active Gaussian traction: its centre p_N (moved with the body) and its direction g (arrow).
-The title gives the shape, load case, achieved max|u|, target and alpha (or why it failed).
+shaded by its normal), the undeformed outline (2D, dashed grey), the Dirichlet patch (red),
+each active Gaussian traction: its centre p_N (moved with the body) and its direction g (arrow),
+and the region of a `pressure` (where its channel is not zero: white dots at the boundary
+vertices in 3D, a dotted black line in 2D).
+The title gives the shape, load case, achieved max|u|, target and alpha (or why it failed), and
+the pressure p drawn for the load case.
 """
 import math
 
 import numpy as np
 
-PATCH_COLOUR, LOAD_COLOUR = "#d62728", "#ff7f0e"
+PATCH_COLOUR, LOAD_COLOUR, PRESSURE_COLOUR = "#d62728", "#ff7f0e", "white"
 
 
 # ---- mesh pieces --------------------------------------------------------------------------
@@ -69,6 +72,12 @@ def _loads(sample):
     return out
 
 
+def _pressed(sample):
+    """Boolean per node: where the sample's pressure channel acts (all False without one)."""
+    p = sample.point_cloud.get("pressure") if sample.point_cloud else None
+    return np.zeros(len(sample.nodes), bool) if p is None else p[:, 0] != 0
+
+
 def _moved(point, nodes, u):
     """A reference point moved with the body (by the displacement of its nearest node)."""
     return point + u[np.argmin(np.sum((nodes - point) ** 2, axis=1))]
@@ -78,7 +87,9 @@ def _title(sample):
     head = f"shape {sample.shape_id}, load {sample.load_id}"
     if sample.status != 1:
         return f"{head}: FAILED\n{sample.reason[:60]}"
-    return f"{head}\nmax|u| {sample.max_displacement:.3f} (target {sample.target:.3f}), alpha {sample.alpha:.3g}"
+    p = sample.params.get("pressure/value")
+    tail = "" if p is None or np.ndim(p) else f", p {float(p):.3g}"
+    return f"{head}\nmax|u| {sample.max_displacement:.3f} (target {sample.target:.3f}), alpha {sample.alpha:.3g}{tail}"
 
 
 # ---- panels -------------------------------------------------------------------------------
@@ -92,6 +103,8 @@ def draw_2d(ax, sample, scale=1.0):
     ax.add_collection(LineCollection(sample.nodes[edges], colors="0.5", linewidths=0.8, linestyles="--"))
     patch = edges[sample.dirichlet_mask[edges].all(axis=1)]
     ax.add_collection(LineCollection(x[patch], colors=PATCH_COLOUR, linewidths=3))
+    pressed = edges[_pressed(sample)[edges].all(axis=1)]
+    ax.add_collection(LineCollection(x[pressed], colors="k", linewidths=1.5, linestyles=":"))
     for p, g in _loads(sample):
         q = _moved(p, sample.nodes, scale * u)
         ax.plot(*q, "o", color=LOAD_COLOUR, ms=5, mec="k", mew=0.5)
@@ -129,7 +142,8 @@ def draw_3d(ax, sample, scale=1.0):
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
     u = sample.displacement
     x, mag = sample.nodes + scale * u, np.linalg.norm(u, axis=1)
-    faces = _split_p2(_boundary(sample.cells, 3), _edge_midpoints(sample.cells, 3))
+    corner_faces = _boundary(sample.cells, 3)
+    faces = _split_p2(corner_faces, _edge_midpoints(sample.cells, 3))
     norm = mpl.colors.Normalize(vmin=0, vmax=max(mag.max(), 1e-12))
     colours = _shade(x[faces], mpl.colormaps["viridis"](norm(mag[faces].mean(axis=1))))
     ax.computed_zorder = False  # the patch and the loads drawn over the surface
@@ -137,12 +151,15 @@ def draw_3d(ax, sample, scale=1.0):
     on_surface = np.unique(faces)
     patch = on_surface[sample.dirichlet_mask[on_surface]]
     ax.scatter(*x[patch].T, s=2, color=PATCH_COLOUR, depthshade=False, zorder=2)
+    corners = np.unique(corner_faces)  # vertices only: P2 edge nodes would crowd
+    pressed = corners[_pressed(sample)[corners]]
+    ax.scatter(*x[pressed].T, s=5, color=PRESSURE_COLOUR, edgecolors="k", linewidths=0.3, depthshade=False, zorder=2)
     loads = _loads(sample)
     for p, g in loads:
         q = _moved(p, sample.nodes, scale * u)
         ax.scatter(*q, s=30, color=LOAD_COLOUR, edgecolors="k", depthshade=False, zorder=3)
         ax.quiver(*q, *g, length=0.6, color=LOAD_COLOUR, linewidth=2, arrow_length_ratio=0.3, zorder=3)
-    _look_at(ax, [p for p, _ in loads[:1]] + [x[patch].mean(axis=0)] if len(patch) else [p for p, _ in loads[:1]])
+    _look_at(ax, [p for p, _ in loads[:1]] + [x[v].mean(axis=0) for v in (patch, pressed) if len(v)])
     for set_lim in (ax.set_xlim, ax.set_ylim, ax.set_zlim):
         set_lim(-1, 1)
     ax.set_box_aspect((1, 1, 1), zoom=1.35)
@@ -164,8 +181,10 @@ def plot(dataset, pairs, out, cols=None, scale=1.0):
         art = (draw_3d if s.dim == 3 else draw_2d)(ax, s, scale)
         fig.colorbar(art, ax=ax, shrink=0.7, pad=0.02, label="|u|")
         ax.set_title(_title(s), fontsize=8)
+    pressure = "; pressure region white dots" if "pressure" in dataset.channels else ""
     fig.suptitle(f"{dataset.name}: deformed shape coloured by |u|; Dirichlet patch red, "
-                 f"traction centre and direction orange" + (f"; u x {scale:g}" if scale != 1 else ""), fontsize=9)
+                 f"traction centre and direction orange{pressure}" + (f"; u x {scale:g}" if scale != 1 else ""),
+                 fontsize=9)
     fig.tight_layout()
     fig.savefig(out)
     plt.close(fig)

@@ -51,13 +51,16 @@ for preset in $PRESETS; do
   made+=("$preset")
 done
 # The example datasets beyond the paper (configs/examples: several tractions with fixed gravity,
-# the effects catalogue), generated as they are (they are small) -> <name>_solutions.png.
+# the effects catalogue, the organ under pressure), the 2D ones generated as they are (they are
+# small), a 3D one (its preset a 3D one) as its --mini dataset -> <name>_solutions.png.
 for config in $CONFIGS; do
   name=$(basename "$config" .yaml)
   dir="$DATA_DIR/$name"
   rm -rf "$dir"
+  mini=()
+  if grep -Eq '^preset:[[:space:]]*(random3d|aug_liver|liver|one_liver)[[:space:]]*$' "$config"; then mini=(--mini); fi
   t0=$(date +%s.%N)
-  "$BIN" -q generate "$config" --progress 0 -o "$dir"
+  "$BIN" -q generate "$config" "${mini[@]}" --progress 0 -o "$dir"
   t_gen=$(seconds_since "$t0")
   /usr/bin/python3 scripts/hypershape_data.py plot "$dir" --gallery 4 -o "$OUT_DIR/${name}_solutions.png"
   echo "   $name: generate ${t_gen} s"
