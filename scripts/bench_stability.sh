@@ -7,7 +7,10 @@
 #   scripts/bench_stability.sh [SHAPES_2D] [SHAPES_3D]   (default 20 x 50 = 1000 load cases per
 #   seed in 2D, 10 x 20 = 200 in 3D; JSON: results/bench_stability.json)
 #   SEEDS="777 2024 31337" SEEDS3D="4242" scripts/bench_stability.sh   (defaults: the presets' own)
-#   NP=2 (ranks, default 2); a second argument of 0 (e.g. `scripts/bench_stability.sh 20 0`) skips 3D.
+#   NP=2 (ranks, default 2); HYPERSHAPE=path/to/binary (default build/hypershape: a copy keeps a long
+#   run on the build it started with); KEEP=dir keeps the datasets there (else a temporary dir);
+#   JSON=file (default results/bench_stability.json); a second argument of 0 (e.g. `scripts/bench_stability.sh 20 0`) skips 3D,
+#   a first one of 0 skips 2D (`SEEDS3D=4242 scripts/bench_stability.sh 0 10`).
 #   CONFIGS="configs/examples/catalogue2d.yaml ..." also runs these dataset configs as they are
 #   but for SHAPES_2D shapes x CONFIG_LOADS load cases (default 50; their shapes: and loads:
 #   counts replaced; the target share by the config's dimension); with CONFIGS and no SEEDS the
@@ -19,8 +22,14 @@ cd "$(dirname "$0")/.."
 shapes2=${1:-20} shapes3=${2:-10}
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
 np=${NP:-2}
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+bin=${HYPERSHAPE:-build/hypershape}
+if [ -n "${KEEP:-}" ]; then
+  work=$KEEP
+  mkdir -p "$work"
+else
+  work=$(mktemp -d)
+  trap 'rm -rf "$work"' EXIT
+fi
 runs=()
 run() {  # $1 family (random2d|random3d), $2 shapes, $3 load cases per shape, $4 seed ("" = preset's)
   local tag="$1-${4:-preset}"
@@ -32,7 +41,7 @@ run() {  # $1 family (random2d|random3d), $2 shapes, $3 load cases per shape, $4
     echo "loads: {count: $3}"
     echo "output: {shard_size: 2}"
   } > "$work/$tag.yaml"
-  mpiexec -n "$np" build/hypershape -q generate "$work/$tag.yaml" --progress 60 -o "$work/$tag"
+  mpiexec -n "$np" "$bin" -q generate "$work/$tag.yaml" --progress 60 -o "$work/$tag"
   runs+=("$tag")
 }
 run_config() {  # $1 a dataset config: its counts replaced, its name by the tag
@@ -40,19 +49,21 @@ run_config() {  # $1 a dataset config: its counts replaced, its name by the tag
   tag="$(basename "$1" .yaml)-config"
   sed -E "s/^(shapes: \{count: )[0-9]+/\1$shapes2/; s/^(loads: \{count: )[0-9]+/\1${CONFIG_LOADS:-50}/; s/^name: .*/name: stability_$tag/" \
     "$1" > "$work/$tag.yaml"
-  mpiexec -n "$np" build/hypershape -q generate "$work/$tag.yaml" --progress 60 -o "$work/$tag"
+  mpiexec -n "$np" "$bin" -q generate "$work/$tag.yaml" --progress 60 -o "$work/$tag"
   runs+=("$tag")
 }
 for c in ${CONFIGS:-}; do run_config "$c"; done
-for s in ${SEEDS:-}; do run random2d "$shapes2" 50 "$s"; done
-[ -z "${SEEDS:-}${CONFIGS:-}" ] && run random2d "$shapes2" 50 ""
+if [ "$shapes2" -gt 0 ]; then
+  for s in ${SEEDS:-}; do run random2d "$shapes2" 50 "$s"; done
+  [ -z "${SEEDS:-}${CONFIGS:-}" ] && run random2d "$shapes2" 50 ""
+fi
 if [ "$shapes3" -gt 0 ]; then
   for s in ${SEEDS3D:-}; do run random3d "$shapes3" 20 "$s"; done
   [ -z "${SEEDS3D:-}" ] && run random3d "$shapes3" 20 ""
 fi
 mkdir -p results
 /usr/bin/python3 - "$work" "${runs[@]}" <<'PY'
-import json, math, sys
+import json, math, os, sys
 sys.path.insert(0, "scripts")
 import hypershape_data as hd
 work, tags = sys.argv[1], sys.argv[2:]
@@ -80,7 +91,7 @@ for tag in tags:
                      for k, reason in enumerate(ds.shape(sid).reasons) if not ds.shape(sid).ok or not ds.shape(sid).status[k]]
     ds.close()
     out[tag] = r
-json.dump(out, open("results/bench_stability.json", "w"), indent=1)
+json.dump(out, open(os.environ.get("JSON", "results/bench_stability.json"), "w"), indent=1)
 print("| family, seed | load cases | converged (95% CI) | target | Newton it./case mean, p50, p90, p99, max | p99 / p50 | recovery share | wall s |")
 print("|---|---|---|---|---|---|---|---|")
 for tag, r in out.items():
@@ -94,5 +105,5 @@ for tag, r in out.items():
 for tag, r in out.items():
     for f in r["failures"]:
         print(f"failed: {tag} shape {f['shape']} load {f['load']}: {f['reason'][:300]}")
-print("JSON: results/bench_stability.json")
+print("JSON:", os.environ.get("JSON", "results/bench_stability.json"))
 PY

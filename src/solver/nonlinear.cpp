@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "hypershape/core/error.hpp"
@@ -169,10 +170,17 @@ TargetResult NonlinearSolver::solve_for_target(double target) {
   TargetResult t = opt_.control == Control::displacement ? follow_path(target, start)
                                                           : search_target(target, start);
   // (t.solves == 0: the path never started, e.g. no tangent at the initial state: no branch.)
-  for (int k = 0; k < opt_.branch_switches && opt_.control == Control::displacement && !t.converged &&
-                  target > 0 && t.solves > 0 && t.newton_iterations < opt_.newton_budget;
-       ++k)
-    switch_branch(target, start, k, t);
+  const std::string first = t.reason;
+  int switches = 0;
+  for (; switches < opt_.branch_switches && opt_.control == Control::displacement && !t.converged &&
+         target > 0 && t.solves > 0 && t.newton_iterations < opt_.newton_budget;
+       ++switches)
+    switch_branch(target, start, switches, t);
+  // A fold verified on the path from rest (follow_path) stays the reason where no switch found
+  // a stable state on another branch: the switches' own outcome follows it.
+  if (!t.converged && switches > 0 && first.rfind("fold:", 0) == 0)
+    t.reason = first + "; " + std::to_string(switches) + " branch switch(es) found no stable state on target (last: " +
+               t.reason.substr(0, 400) + ")";
   if (opt_.control == Control::displacement && !t.converged && opt_.fallback && target > 0) {
     // Fallback, measured on Random2D draws: where the path cannot be followed (Newton stalls
     // next to a bifurcation), load-controlled solves from the last converged state of the

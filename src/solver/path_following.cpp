@@ -16,6 +16,35 @@
 
 namespace hypershape::solver {
 
+namespace {
+
+/// The load's extremes along a path and where they were (a fold's limit points).
+struct LoadExtremes {
+  double max_alpha = -INFINITY, d_at_max = 0, min_alpha = INFINITY, d_at_min = 0;
+  void add(double alpha, double d) {
+    if (alpha > max_alpha) max_alpha = alpha, d_at_max = d;
+    if (alpha < min_alpha) min_alpha = alpha, d_at_min = d;
+  }
+};
+
+/// The reason of an equilibrium on target whose own tangent has `negative` negative eigenvalues,
+/// with slope = d max|u| / d alpha there (c . K^-1 f_ext). A fold where one eigenvalue is
+/// negative and max|u| falls as the load rises: the path (one state per max|u|, continuous)
+/// passed a limit point of the load between its start and the target, and its one state with
+/// max|u| = target is unstable: no stable equilibrium on target is on this path.
+std::string unstable_reason(double target, double alpha, int negative, double slope, const LoadExtremes& e) {
+  auto num = [](double x) { return std::to_string(x); };
+  if (negative == 1 && slope < 0)
+    return "fold: max|u| = target lies on an unstable segment of the path (at max|u| = " + num(target) +
+           ", alpha = " + num(alpha) + ": d max|u| / d alpha = " + num(slope) +
+           " < 0, 1 negative eigenvalue; the path's load before: max " + num(e.max_alpha) + " at max|u| = " +
+           num(e.d_at_max) + ", min " + num(e.min_alpha) + " at max|u| = " + num(e.d_at_min) + ")";
+  return "loss of stability at max|u| = " + num(target) + ", alpha = " + num(alpha) + ": the tangent has " +
+         std::to_string(negative) + " negative eigenvalue(s) (buckling or a bifurcation)";
+}
+
+}  // namespace
+
 double NonlinearSolver::control_direction(Vec u, Vec fallback, Vec c) {
   DM dm = problem_.dm();
   const int dim = problem_.space().dim();
@@ -23,6 +52,7 @@ double NonlinearSolver::control_direction(Vec u, Vec fallback, Vec c) {
   Vec ul, cl;
   HS_PETSC(DMGetLocalVector(dm, &ul));
   HS_PETSC(DMGetLocalVector(dm, &cl));
+  std::int64_t node = -1;
   // The node of the largest |v| (ties: the smallest canonical index, on any rank count).
   auto largest = [&](Vec v, PetscInt& offset, double& norm2) {
     HS_PETSC(VecSet(ul, 0.0));
@@ -42,6 +72,7 @@ double NonlinearSolver::control_direction(Vec u, Vec fallback, Vec c) {
     MPI_Allreduce(MPI_IN_PLACE, &gid, 1, MPI_INT64_T, MPI_MIN, comm);
     if (!(best == gbest && id == gid)) offset = -1;  // another rank owns the node
     norm2 = gbest;
+    node = gid;
   };
   PetscInt off;
   double m2;
@@ -59,6 +90,7 @@ double NonlinearSolver::control_direction(Vec u, Vec fallback, Vec c) {
   HS_PETSC(DMRestoreLocalVector(dm, &ul));
   PetscReal cu;
   HS_PETSC(VecDot(c, u, &cu));
+  HS_PETSC(PetscInfo(snes_.get(), "control node %" PetscInt64_FMT ": |u_k| %.10g\n", (PetscInt64)node, double(cu)));
   return cu;  // = max|u| (0 when u = 0)
 }
 
@@ -226,6 +258,8 @@ TargetResult NonlinearSolver::follow_path(double target, double start, int spent
   const double min_step = std::abs(target - d) * std::max(opt_.min_increment, 1e-3);
   int its = spent;  // the Newton budget counts what the target solve spent before
   std::string why;
+  LoadExtremes extremes;
+  extremes.add(s_, d);
   while (true) {
     const bool last = std::abs(target - d) <= std::abs(step) * (1 + 1e-12);
     const double d_next = last ? target : d + step;
@@ -244,15 +278,25 @@ TargetResult NonlinearSolver::follow_path(double target, double start, int spent
       // the elastic equilibria are path-independent, and intermediate states are converged
       // to path_rtol only, where the inertia of a state far from equilibrium would reject
       // good paths (measured: 25 against 13 such failures in 1000 Random2D load cases).
-      t.reason = "loss of stability at max|u| = " + std::to_string(d_next) + ", alpha = " +
-                 std::to_string(s_) + ": the tangent has " + std::to_string(negative_pivots_) +
-                 " negative eigenvalue(s) (buckling or a bifurcation)";
-      ++t.increments;
-      d = d_next;
-      break;
+      // Judged and classified on this state's own tangent (the corrector's last factor is one
+      // Newton step older): its inertia and d max|u| / d alpha = c . K^-1 f_ext.
+      const int older = negative_pivots_;
+      PetscReal slope = 0;
+      if (factorise_here() && tangent_->apply_factor(problem_.load(), w_)) {
+        control_direction(u_, w_, c_);
+        HS_PETSC(VecDot(c_, w_, &slope));
+      }
+      if (negative_pivots_ < 0) negative_pivots_ = older;
+      if (negative_pivots_ > 0) {
+        t.reason = unstable_reason(d_next, s_, negative_pivots_, slope, extremes);
+        ++t.increments;
+        d = d_next;
+        break;
+      }
     }
     if (ok) {
       ++t.increments;
+      extremes.add(s_, d_next);
       failed_in_a_row = 0;
       if (first_accepted && from_rest) step_hint_ = d_next;
       first_accepted = false;
