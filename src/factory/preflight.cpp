@@ -20,7 +20,7 @@ DatasetEstimate estimate_dataset(const config::DatasetConfig& cfg) {
   // A shape fills about 2.5 of the box's 4 (2D) / 8 (3D); vertices of a simplex mesh of size h:
   // 1.15 / h^2 per area, 1.5 / h^3 per volume; P2 adds edge nodes (x4 in 2D, x8 in 3D).
   // A dataset asked for by accuracy: at its ladder's level 1 (a shape's level is known only once
-  // it is solved; measured on Random2D at rel_l2 0.01: most shapes there, docs/ACCURACY.md).
+  // it is solved; Random2D at rel_l2 0.01 went to level 2, 4x these sizes: docs/ACCURACY.md).
   const int d = cfg.shapes.dim;
   const AccuracyLevel level = accuracy_level(cfg, cfg.accuracy.enabled() ? std::min(1, cfg.accuracy.max_level) : 0);
   const double h = level.h;
