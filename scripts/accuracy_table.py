@@ -42,7 +42,7 @@ def row(d, cpu):
                     est += list(g["loads/error_estimate_rel_l2"][...][st == 1])
     est = np.array(est)
     acc = rep.get("accuracy", {})
-    name = os.path.basename(os.path.normpath(d)).removeprefix("out_")
+    name = os.path.basename(os.path.normpath(d)).removeprefix("out2_").removeprefix("out_")
     bound = acc.get("rel_l2_bound")
     meets = f"{100 * acc['share_meeting']:.1f}%" if acc else "-"
     lv = ", ".join(f"{k}: {levels.count(k)}" for k in sorted(set(levels))) if acc else "-"
