@@ -154,8 +154,8 @@ void parse_shapes(const YamlBlock& b, const std::string& base_dir, factory::Shap
 /// would otherwise replace the preset's mapping, or reach yaml-cpp's operator[]).
 void check_sections(const YAML::Node& root, const std::string& source) {
   const YamlBlock top(root, source, "");
-  for (const char* s : {"shapes", "loads", "material", "effects", "mesh", "representations", "split", "output",
-                        "solver", "petsc"})
+  for (const char* s : {"shapes", "loads", "material", "effects", "mesh", "representations", "accuracy", "split",
+                        "output", "solver", "petsc"})
     (void)top.mapping(s);
 }
 
@@ -422,6 +422,35 @@ void parse_representations(const YamlBlock& top, const std::string& source, Data
   r.check_all_used();
 }
 
+/// accuracy: the bound (required when the block is given) and the ladder's limits; it implies
+/// the error estimate (the indicator), so `representations.error_estimate: false` contradicts it.
+void parse_accuracy(const YamlBlock& top, const std::string& source, DatasetConfig& c) {
+  if (!top.has("accuracy")) return;
+  YamlBlock a(top.get("accuracy"), source, "accuracy");
+  auto& acc = c.accuracy;
+  if (!a.has("rel_l2")) a.fail("rel_l2", "missing (the bound on each load case's estimated relative L2 error of u, "
+                                         "a number in (0, 1), e.g. 0.01)");
+  acc.rel_l2 = a.number("rel_l2");
+  if (!(acc.rel_l2 > 0 && acc.rel_l2 < 1)) a.fail("rel_l2", "must be a number in (0, 1), e.g. 0.01");
+  if (a.has("max_level")) {
+    const long l = a.integer("max_level");
+    if (l < 0 || l > 3) a.fail("max_level", "must be in [0, 3] (the finest level of the ladder)");
+    acc.max_level = int(l);
+  }
+  if (a.has("exceed_share")) {
+    acc.exceed_share = a.number("exceed_share");
+    if (!(acc.exceed_share >= 0 && acc.exceed_share <= 0.5))
+      a.fail("exceed_share", "must be in [0, 0.5] (share of a shape's load cases allowed above the bound)");
+  }
+  a.allowed("rel_l2, max_level, exceed_share");
+  a.check_all_used();
+  const YAML::Node rep = top.get("representations");
+  if (rep && rep["error_estimate"] && !c.representations.error_estimate)
+    throw InputError(source, "representations.error_estimate",
+                     "accuracy: needs the error estimate (it is the indicator): leave error_estimate out or true");
+  c.representations.error_estimate = true;
+}
+
 void parse_split(const YamlBlock& top, const std::string& source, DatasetConfig& c) {
   YamlBlock s(top.get("split"), source, "split");
   auto& sp = c.split;
@@ -512,11 +541,13 @@ DatasetConfig parse_dataset_text(const std::string& text, const std::string& sou
   }
   parse_mesh(top, source, c);
   parse_representations(top, source, c);
+  parse_accuracy(top, source, c);
   parse_split(top, source, c);
   parse_output(top, source, c);
   parse_solver_block(YamlBlock(top.get("solver"), source, "solver"), c.solver);
   parse_petsc_block(YamlBlock(top.get("petsc"), source, "petsc"), c.petsc);
-  top.allowed("preset, name, seed, shapes, loads, material, effects, mesh, representations, split, output, solver, petsc");
+  top.allowed("preset, name, seed, shapes, loads, material, effects, mesh, representations, accuracy, split, output, "
+              "solver, petsc");
   top.check_all_used();
   c.text = resolved_text(root, c);
   return c;

@@ -67,6 +67,8 @@ std::string canonical_text(const DatasetConfig& c) {
                    r.point_cloud, r.grid, r.grid_size, num(c.split.train), num(c.split.val), num(c.split.test),
                    c.shard_size);
   if (r.error_estimate) t += "error_estimate: true\n";  // only when asked for: older datasets keep their identity
+  if (const auto& a = c.accuracy; a.enabled())  // likewise
+    t += fmt::format("accuracy: [{}, {}, {}]\n", num(a.rel_l2), a.max_level, num(a.exceed_share));
   t += solver_text(c.solver);
   // PETSc options in a fixed order (the order they are written in does not matter).
   auto petsc = c.petsc;

@@ -285,6 +285,7 @@ void add_to_report(const ShapeJobResult& r, RunReport& rep) {
   rep.shapes_failed += r.entry.ok ? 0 : 1;
   rep.counters += r.counters;
   rep.label_error += r.label_error;
+  rep.accuracy += r.accuracy;
 }
 
 /// The run report's numbers over `comm`: counters summed over the group roots (each holds its
@@ -309,6 +310,7 @@ void reduce_report(MPI_Comm comm, bool group_root, const core::PhaseTimes& times
   rep.counters.sum_over(comm, group_root);
   rep.shards_written = sum_roots(shards_written);
   rep.label_error.sum_over(comm, group_root);
+  rep.accuracy.sum_over(comm, group_root);
   const std::vector<std::string> phases = {"shape", "mesh", "setup", "solve", "alpha_search",
                                            "error_estimate", "representations", "gather", "io"};
   for (const auto& p : phases) {
@@ -348,6 +350,7 @@ bool report_and_index(const config::DatasetConfig& cfg, const GenerateOptions& o
                      {"per_second", double(c.loads()) / std::max(1e-9, rep.seconds)}};
   j["solver"] = c.solver_json();
   j["label_error_estimate"] = rep.label_error.json();
+  if (cfg.accuracy.enabled()) j["accuracy"] = rep.accuracy.json(cfg.accuracy);
   j["seconds"] = {{"wall", rep.seconds}, {"phases_summed_over_groups", rep.phase_seconds},
                   {"factorization_PCSetUp_summed_over_ranks", rep.factorization_seconds}};
   j["peak_rss_mib_per_rank"] = rss;
@@ -484,6 +487,7 @@ RunReport generate(MPI_Comm comm, const config::DatasetConfig& cfg, const Genera
   const double start = core::now_seconds();
   const int size = core::size(comm);
   RunReport rep;
+  rep.accuracy_config = cfg.accuracy;
   const std::int64_t S = cfg.shard_size;
   rep.shards_total = (cfg.n_shapes + S - 1) / S;
   // The base surface is read (and so checked) before anything is written.
@@ -539,6 +543,7 @@ std::string report_table(const RunReport& r) {
     s += fmt::format("  {:<17s} {:8.2f}  {:5.1f}%\n", k, v, 100 * v / std::max(1e-9, total));
   s += fmt::format("  (factorisations, PCSetUp: {:.2f} s of solve + alpha_search)\n", r.factorization_seconds);
   s += r.label_error.line();
+  s += r.accuracy.line(r.accuracy_config);
   return s;
 }
 

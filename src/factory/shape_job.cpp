@@ -8,6 +8,7 @@
 #include <numeric>
 
 #include "hypershape/core/error.hpp"
+#include "hypershape/factory/accuracy.hpp"
 #include "hypershape/factory/dataset_schema.hpp"
 #include "hypershape/factory/label_error.hpp"
 #include "hypershape/factory/load_cases.hpp"
@@ -433,22 +434,30 @@ LoadOutcome solve_load_case(MPI_Comm group, const config::DatasetConfig& cfg, co
   return o;
 }
 
-}  // namespace
+/// How a shape's load cases went at one discretisation: the converged ones' estimates (-1: none)
+/// and whether the loop was stopped early (the accuracy ladder abandoned the level).
+struct ShapeSolve {
+  std::vector<std::int8_t> status;
+  std::vector<double> rel_l2;
+  bool stopped = false;
+};
 
-ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
-                         const std::optional<geometry::Boundary>& base, std::int64_t shape_id,
-                         const std::function<void(bool)>& on_load) {
-  ShapeJobResult out;
+/// Stops a shape's load-case loop after load case L: (status, estimates so far, L) -> stop.
+using StopRule = std::function<bool(const std::vector<std::int8_t>&, const std::vector<double>&, std::size_t)>;
+
+/// Solves every load case of `shape` (already drawn, its record in out.entry.shape) on the
+/// discretisation of `cfg` and fills `out`, unless `stop` ends the loop (then `out` is partial:
+/// its counters and times are real, its arrays are not to be stored). Collective over `group`.
+ShapeSolve solve_shape(MPI_Comm group, const config::DatasetConfig& cfg, const ShapeSample& shape,
+                       const std::vector<LoadCase>& cases, const StopRule& stop,
+                       const std::function<void(bool)>& on_load, ShapeJobResult& out) {
   const bool root = core::rank(group) == 0;
   const int n_loads = cfg.loads.count;
-  const std::optional<ShapeSample> shape = draw_shape(cfg, base, shape_id, out);
-  if (!shape) return out;
-  const auto cases = draw_load_cases(*shape, cfg.loads, cfg.seed, n_tractions(cfg));
   ShapeProblem sp;
   std::unique_ptr<solver::NonlinearSolver> nl;
   {  // the problem, set up once for all load cases
     auto t = out.times.scope("setup");
-    sp = make_shape_problem(group, cfg, *shape, cases[0]);
+    sp = make_shape_problem(group, cfg, shape, cases[0]);
     nl = std::make_unique<solver::NonlinearSolver>(*sp.problem, cfg.solver);
   }
   out.n_dofs = sp.problem->space().n_dofs_global();
@@ -457,38 +466,51 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
   ShapeFields fields;
   if (root) {
     auto t = out.times.scope("representations");
-    fields = shape_fields(cfg, *shape, sp.problem->space(), moments, arrays);
+    fields = shape_fields(cfg, shape, sp.problem->space(), moments, arrays);
   }
   LoadTable table(n_loads, cfg.shapes.dim);
   LoadFields load_fields(*sp.problem, cfg, fields, n_loads);
-  DrawnParams drawn(cfg, shape_id, n_loads);
+  DrawnParams drawn(cfg, shape.shape_id, n_loads);
   LabelErrors label_errors(cfg, n_loads);
+  ShapeSolve result;
   if (root) load_fields.allocate();
   for (int l = 0; l < n_loads; ++l) {
     const auto L = std::size_t(l);
     table.set_case(L, cases[L]);
     drawn.add(cases[L]);  // before anything that may fail: one row per load case
-    LoadOutcome o = solve_load_case(group, cfg, *shape, sp, *nl, cases[L], out.times, table.normaliser[L]);
+    LoadOutcome o = solve_load_case(group, cfg, shape, sp, *nl, cases[L], out.times, table.normaliser[L]);
     table.set_cost(L, o.result);
     out.counters.add(o.result);
     table.status[L] = o.ok ? 1 : 0;
     table.reasons[L] = o.reason;
     (o.ok ? out.counters.loads_ok : out.counters.loads_failed) += 1;
     if (on_load) on_load(o.ok);
-    if (!o.ok) continue;  // the row and the fields stay zero: never NaN
-    table.max_u[L] = o.max_u, table.min_det[L] = o.min_det, table.alpha[L] = o.result.alpha;
-    {
-      auto t = out.times.scope("error_estimate");
-      // The coarse level: the factor the solve left (no second coarse factorisation).
-      label_errors.estimate(group, cfg, *shape, cases[0], cases[L], *sp.problem, nl->solution(), o.result.alpha,
-                            [&](Vec x, Vec y) { return nl->apply_tangent_factor(x, y); });
+    if (o.ok) {
+      table.max_u[L] = o.max_u, table.min_det[L] = o.min_det, table.alpha[L] = o.result.alpha;
+      {
+        auto t = out.times.scope("error_estimate");
+        // The coarse level: the factor the solve left (no second coarse factorisation).
+        label_errors.estimate(group, cfg, shape, cases[0], cases[L], *sp.problem, nl->solution(), o.result.alpha,
+                              [&](Vec x, Vec y) { return nl->apply_tangent_factor(x, y); });
+      }
+      if (root) {
+        auto t = out.times.scope("representations");
+        load_fields.fill(*sp.problem, L, table.alpha[L], o.u.values, moments);
+        moments.add("alpha", &table.alpha[L], 1, 1);
+      }
+    }  // a failed load case: the row and the fields stay zero, never NaN
+    if (stop) {  // the group root decides (the estimates agree on every rank; one decision all the same)
+      int s = root && stop(table.status, label_errors.rel_l2(), L) ? 1 : 0;
+      MPI_Bcast(&s, 1, MPI_INT, 0, group);
+      if (s) {
+        result.stopped = true;
+        break;
+      }
     }
-    if (!root) continue;
-    auto t = out.times.scope("representations");
-    load_fields.fill(*sp.problem, L, table.alpha[L], o.u.values, moments);
-    moments.add("alpha", &table.alpha[L], 1, 1);
   }
-  if (root) {
+  result.status = table.status;
+  result.rel_l2 = label_errors.rel_l2();
+  if (root && !result.stopped) {
     auto t = out.times.scope("representations");
     table.store(arrays, n_tractions(cfg) > 0);
     load_fields.store(arrays);
@@ -498,6 +520,103 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
     moments.store(arrays);
     out.entry.load_reasons = std::move(table.reasons);
   }
+  return result;
+}
+
+/// The record of a shape as solved (its mesh), without the timings that would make it differ
+/// from one run to the next.
+io::ShapeRecord solved_record(const ShapeSample& shape) {
+  io::ShapeRecord r = to_record(shape);
+  for (auto it = r.numbers.begin(); it != r.numbers.end();)
+    it = it->first.rfind("seconds_", 0) == 0 ? r.numbers.erase(it) : std::next(it);
+  return r;
+}
+
+/// The largest estimate of the converged load cases (-1 when none was formed) and how many
+/// converged load cases miss the bound.
+std::pair<double, std::int64_t> worst_estimate(const config::AccuracyConfig& a, const ShapeSolve& s) {
+  double worst = -1;
+  std::int64_t n_exceeding = 0;
+  for (std::size_t k = 0; k < s.status.size() && k < s.rel_l2.size(); ++k) {
+    if (!s.status[k]) continue;
+    worst = std::max(worst, s.rel_l2[k]);
+    n_exceeding += exceeds(a, s.rel_l2[k]);
+  }
+  return {worst, n_exceeding};
+}
+
+/// The accuracy ladder (factory/accuracy.hpp) on one drawn shape: levels are solved until one
+/// meets the bound on all but the allowed share of its load cases, or the last is reached;
+/// the kept level is `out`, the abandoned ones are counted in out.accuracy (and their solver work
+/// and times in out.counters and out.times: they were spent).
+void solve_by_accuracy(MPI_Comm group, const config::DatasetConfig& cfg, const ShapeSample& drawn,
+                       const std::vector<LoadCase>& cases, const std::function<void(bool)>& on_load,
+                       ShapeJobResult& out) {
+  const auto& acc = cfg.accuracy;
+  const auto allowed = std::int64_t(std::floor(acc.exceed_share * double(cfg.loads.count) + 1e-9));
+  const StopRule miss = [&](const std::vector<std::int8_t>& status, const std::vector<double>& est, std::size_t L) {
+    std::int64_t n = 0;
+    for (std::size_t k = 0; k <= L; ++k) n += status[k] && exceeds(acc, est[k]);
+    return n > allowed;
+  };
+  ShapeSample shape = drawn;
+  int refinements = 0;
+  for (int level = 0;;) {
+    const AccuracyLevel a = accuracy_level(cfg, level);
+    for (; refinements < a.refinements; ++refinements) shape = refine_shape(shape);
+    config::DatasetConfig at = cfg;
+    at.degree = a.degree;
+    ShapeJobResult attempt;
+    attempt.entry.shape = solved_record(shape);
+    std::vector<char> oks;
+    const bool last = level >= acc.max_level;
+    const ShapeSolve s = solve_shape(group, at, shape, cases, last ? StopRule{} : miss,
+                                     [&](bool ok) { oks.push_back(ok); }, attempt);
+    for (const auto& [name, sec] : attempt.times.all()) out.times.add(name, sec);
+    const auto [worst, n_exceeding] = worst_estimate(acc, s);
+    if (!s.stopped) {  // kept: this level is the shape's
+      const core::PhaseTimes times = out.times;
+      SolveCounters spent = out.counters;
+      const AccuracySummary ladder = out.accuracy;
+      out = std::move(attempt);
+      out.times = times;
+      out.counters += spent;  // the abandoned levels' solver work (no load case of theirs counts)
+      out.accuracy = ladder;
+      out.accuracy.shapes_at_level[std::size_t(level)] += 1;
+      out.accuracy.loads_exceeding += n_exceeding;
+      out.accuracy.loads_meeting += out.counters.loads_ok - n_exceeding;
+      auto& numbers = out.entry.shape.numbers;
+      numbers["accuracy_level"] = level;
+      numbers["accuracy_degree"] = a.degree;
+      numbers["accuracy_h"] = a.h;
+      numbers["accuracy_estimate_max"] = worst;
+      numbers["accuracy_exceeding"] = double(n_exceeding);
+      numbers["accuracy_discarded_load_cases"] = double(out.accuracy.discarded_loads);
+      if (on_load)
+        for (char ok : oks) on_load(ok != 0);
+      return;
+    }
+    out.accuracy.escalations += 1;
+    out.accuracy.discarded_loads += attempt.counters.loads();
+    out.accuracy.discarded_newton += attempt.counters.newton_iterations;
+    out.accuracy.discarded_factorizations += attempt.counters.linear.numeric_factorizations;
+    attempt.counters.loads_ok = attempt.counters.loads_failed = 0;
+    out.counters += attempt.counters;
+    level = next_accuracy_level(cfg, level, worst);
+  }
+}
+
+}  // namespace
+
+ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
+                         const std::optional<geometry::Boundary>& base, std::int64_t shape_id,
+                         const std::function<void(bool)>& on_load) {
+  ShapeJobResult out;
+  const std::optional<ShapeSample> shape = draw_shape(cfg, base, shape_id, out);
+  if (!shape) return out;
+  const auto cases = draw_load_cases(*shape, cfg.loads, cfg.seed, n_tractions(cfg));
+  if (cfg.accuracy.enabled()) solve_by_accuracy(group, cfg, *shape, cases, on_load, out);
+  else (void)solve_shape(group, cfg, *shape, cases, {}, on_load, out);
   return out;
 }
 

@@ -47,6 +47,11 @@
 ///   point_cloud: true             # SDF, Dirichlet distance and traction at the mesh nodes
 ///   grid: true                    # SDF, Dirichlet distance, traction, displacement on a grid
 ///   grid_size: 128                # points per axis over [-1, 1]^d (default 128 2D, 64 3D)
+/// accuracy: {rel_l2: 0.01}       # optional: the factory chooses each shape's discretisation so
+///                                 # that every load case's estimate meets the bound (implies
+///                                 # representations.error_estimate; see factory/accuracy.hpp);
+///                                 # max_level: 2 (the ladder's last level), exceed_share: 0
+///                                 # (share of a shape's load cases allowed above the bound)
 /// split: {train: 0.8, val: 0.1, test: 0.1}   # by shape, deterministic
 /// output: {shard_size: 8}         # shapes per HDF5 shard (the unit of work and of resume)
 /// solver: {rtol: 1e-9, max_newton: 12, factor_reuse: false, krylov_budget: 0, krylov_rtol: 1e-3, max_increments: 64, target_rtol: 1e-3,
@@ -85,6 +90,14 @@ struct RepresentationsConfig {
   bool error_estimate = false;  ///< loads/error_estimate_*: each label's estimated error (costs about a solve)
 };
 
+/// `accuracy:`: datasets asked for by accuracy (issue 19). Off when rel_l2 is 0.
+struct AccuracyConfig {
+  double rel_l2 = 0.0;        ///< bound on each load case's estimated relative L2 error of u, in (0, 1)
+  int max_level = 2;          ///< the finest level of the ladder (factory::accuracy_level), in [0, 3]
+  double exceed_share = 0.0;  ///< share of a shape's load cases that may stay above the bound, in [0, 0.5]
+  bool enabled() const { return rel_l2 > 0; }
+};
+
 struct SplitConfig {
   double train = 0.8, val = 0.1, test = 0.1;
 };
@@ -105,6 +118,7 @@ struct DatasetConfig {
   bool scene_given = false;  ///< `effects:` was written (else: the shorthands)
   int degree = 1;
   RepresentationsConfig representations;
+  AccuracyConfig accuracy;
   SplitConfig split;
   int shard_size = 8;
   solver::SolverOptions solver;

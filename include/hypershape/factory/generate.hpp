@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "hypershape/config/dataset.hpp"
+#include "hypershape/factory/accuracy.hpp"
 #include "hypershape/factory/label_error.hpp"
 #include "hypershape/factory/solve_counters.hpp"
 
@@ -46,6 +47,8 @@ struct RunReport {
   std::map<std::string, double> phase_seconds;  ///< summed over group roots
   double factorization_seconds = 0;             ///< PCSetUp, summed over ranks
   LabelErrorSummary label_error;  ///< the labels' error estimates over the converged load cases
+  config::AccuracyConfig accuracy_config;  ///< the dataset's accuracy: block (off: no accuracy report)
+  AccuracySummary accuracy;       ///< what the accuracy ladder chose and what it cost
   std::string json;                              ///< the report as written (rank 0)
   bool indexed = false;                          ///< manifest written (dataset complete)
 };

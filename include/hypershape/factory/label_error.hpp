@@ -70,6 +70,8 @@ class LabelErrors {
   /// Appends the three arrays (group root).
   void store(std::vector<io::Array>& arrays) const;
   bool enabled() const { return enabled_; }
+  /// Per load case: the estimated relative L2 error (0: not converged or not estimated, -1: none formed).
+  const std::vector<double>& rel_l2() const { return rel_l2_; }
   /// Over the converged load cases (status 1).
   LabelErrorSummary summary(const std::vector<std::int8_t>& status) const;
 

@@ -12,6 +12,7 @@
 
 #include "hypershape/config/dataset.hpp"
 #include "hypershape/core/timer.hpp"
+#include "hypershape/factory/accuracy.hpp"
 #include "hypershape/factory/dataset_scene.hpp"
 #include "hypershape/factory/label_error.hpp"
 #include "hypershape/factory/load_cases.hpp"
@@ -28,6 +29,7 @@ struct ShapeJobResult {
   io::ShardShape entry;      ///< significant on rank 0 of the group
   SolveCounters counters;    ///< the shape's load cases: outcomes and solver work
   LabelErrorSummary label_error;  ///< the estimates of its converged load cases (if asked for)
+  AccuracySummary accuracy;       ///< the accuracy ladder's choice and cost (config accuracy:)
   std::int64_t n_dofs = 0;
   /// shape (draw + boundary + checks), mesh, setup, solve (first nonlinear solve of each load
   /// case), alpha_search (the further solves), representations, gather.

@@ -1,0 +1,168 @@
+#include "hypershape/factory/accuracy.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <stdexcept>
+
+#include "hypershape/mesh/refine.hpp"
+
+namespace hypershape::factory {
+
+AccuracyLevel accuracy_level(const config::DatasetConfig& cfg, int level) {
+  AccuracyLevel a;
+  a.level = level;
+  const int base = cfg.degree;
+  a.degree = base == 1 && level == 0 ? 1 : 2;
+  a.refinements = base == 1 ? std::max(0, level - 1) : level;
+  a.h = std::max(cfg.shapes.h, cfg.shapes.mesh_h) / double(1 << a.refinements);
+  return a;
+}
+
+double predicted_reduction(const AccuracyLevel& from, const AccuracyLevel& to) {
+  const double degree = from.degree == 1 && to.degree == 2 ? 10.0 : 1.0;
+  return degree * std::pow(2.0, to.refinements - from.refinements);
+}
+
+int next_accuracy_level(const config::DatasetConfig& cfg, int current, double worst) {
+  const int last = cfg.accuracy.max_level;
+  if (worst < 0) return std::min(current + 1, last);
+  const AccuracyLevel from = accuracy_level(cfg, current);
+  for (int k = current + 1; k < last; ++k)
+    if (worst / predicted_reduction(from, accuracy_level(cfg, k)) <= cfg.accuracy.rel_l2) return k;
+  return std::max(current + 1, last);
+}
+
+namespace {
+
+/// The fine vertex at the midpoint of each coarse edge (a < b), read from the children's
+/// barycentric coordinates (a midpoint has two entries of exactly 0.5).
+std::map<std::pair<int, int>, int> midpoints(const mesh::RefinedMesh& r, int d) {
+  const int nv = d + 1;
+  std::map<std::pair<int, int>, int> mid;
+  for (std::int64_t k = 0; k < r.mesh.n_cells(); ++k) {
+    const auto parent = std::size_t(r.parent[std::size_t(k)]);
+    for (int j = 0; j < nv; ++j) {
+      const double* lam = &r.bary[(std::size_t(k) * std::size_t(nv) + std::size_t(j)) * std::size_t(nv)];
+      int ends[2] = {-1, -1}, n = 0;
+      for (int i = 0; i < nv; ++i)
+        if (lam[i] == 0.5 && n < 2) ends[n++] = r.coarse_cells[parent * std::size_t(nv) + std::size_t(i)];
+      if (n == 2) mid[std::minmax(ends[0], ends[1])] = r.mesh.cells[std::size_t(k) * std::size_t(nv) + std::size_t(j)];
+    }
+  }
+  return mid;
+}
+
+/// Children of boundary facet (local corners; 3 = m01, 4 = m12, 5 = m20 in 3D, 2 = m01 in 2D), each
+/// oriented as its parent.
+const std::vector<std::array<int, 3>>& facet_children(int d) {
+  static const std::vector<std::array<int, 3>> c2{{0, 2, 0}, {2, 1, 0}};
+  static const std::vector<std::array<int, 3>> c3{{0, 3, 5}, {3, 1, 4}, {5, 4, 2}, {3, 4, 5}};
+  return d == 2 ? c2 : c3;
+}
+
+}  // namespace
+
+ShapeSample refine_shape(const ShapeSample& shape) {
+  const int d = shape.mesh.dim;
+  const mesh::RefinedMesh r = mesh::refine_uniform(shape.mesh);
+  const auto mid = midpoints(r, d);
+  const geometry::Boundary& b = shape.boundary;
+  // New numbering: the boundary's nodes first (in 2D along the polygon), then the rest in order.
+  std::vector<int> renum(std::size_t(r.mesh.n_vertices()), -1);
+  int next = 0;
+  auto take = [&](int v) {
+    if (renum[std::size_t(v)] < 0) renum[std::size_t(v)] = next++;
+    return renum[std::size_t(v)];
+  };
+  std::vector<std::array<int, 6>> corners(std::size_t(b.n_facets()));  // fine ids: vertices, then midpoints
+  for (std::int64_t f = 0; f < b.n_facets(); ++f) {
+    const auto v = b.facet(f);
+    auto& c = corners[std::size_t(f)];
+    for (int i = 0; i < d; ++i) c[std::size_t(i)] = v[std::size_t(i)];
+    for (int i = 0; i < (d == 2 ? 1 : 3); ++i) {
+      const auto it = mid.find(std::minmax(v[std::size_t(i)], v[std::size_t((i + 1) % d)]));
+      if (it == mid.end()) throw std::logic_error("refine_shape: a boundary facet is not an edge/face of the mesh");
+      c[std::size_t(d + i)] = it->second;
+    }
+    if (d == 2) take(c[0]), take(c[2]), take(c[1]);
+    else for (int i = 0; i < 6; ++i) take(c[std::size_t(i)]);
+  }
+  const int n_boundary = next;
+  for (std::size_t v = 0; v < renum.size(); ++v) take(int(v));
+  ShapeSample out = shape;
+  out.mesh.dim = d;
+  out.mesh.coords.assign(r.mesh.coords.size(), 0.0);
+  for (std::size_t v = 0; v < renum.size(); ++v)
+    for (int k = 0; k < d; ++k)
+      out.mesh.coords[std::size_t(renum[v]) * std::size_t(d) + std::size_t(k)] = r.mesh.coords[v * std::size_t(d) + std::size_t(k)];
+  out.mesh.cells.resize(r.mesh.cells.size());
+  for (std::size_t i = 0; i < r.mesh.cells.size(); ++i) out.mesh.cells[i] = renum[std::size_t(r.mesh.cells[i])];
+  out.boundary.dim = d;
+  out.boundary.points.assign(out.mesh.coords.begin(), out.mesh.coords.begin() + std::ptrdiff_t(n_boundary * d));
+  out.boundary.facets.clear();
+  const auto& children = facet_children(d);
+  for (const auto& c : corners)
+    for (const auto& ch : children)
+      for (int i = 0; i < d; ++i) out.boundary.facets.push_back(renum[std::size_t(c[std::size_t(ch[std::size_t(i)])])]);
+  out.dirichlet_facets.clear();
+  for (int f : shape.dirichlet_facets)
+    for (std::size_t k = 0; k < children.size(); ++k) out.dirichlet_facets.push_back(f * int(children.size()) + int(k));
+  return out;
+}
+
+AccuracySummary& AccuracySummary::operator+=(const AccuracySummary& o) {
+  for (int k = 0; k < kLevels; ++k) shapes_at_level[std::size_t(k)] += o.shapes_at_level[std::size_t(k)];
+  loads_meeting += o.loads_meeting, loads_exceeding += o.loads_exceeding, escalations += o.escalations;
+  discarded_loads += o.discarded_loads, discarded_newton += o.discarded_newton;
+  discarded_factorizations += o.discarded_factorizations;
+  return *this;
+}
+
+void AccuracySummary::sum_over(MPI_Comm comm, bool contribute) {
+  std::array<std::int64_t, kLevels + 6> v{}, t{};
+  for (int k = 0; k < kLevels; ++k) v[std::size_t(k)] = shapes_at_level[std::size_t(k)];
+  const std::array<std::int64_t*, 6> rest{&loads_meeting, &loads_exceeding, &escalations, &discarded_loads,
+                                          &discarded_newton, &discarded_factorizations};
+  for (std::size_t i = 0; i < rest.size(); ++i) v[kLevels + i] = *rest[i];
+  if (!contribute) v.fill(0);
+  MPI_Allreduce(v.data(), t.data(), int(v.size()), MPI_INT64_T, MPI_SUM, comm);
+  for (int k = 0; k < kLevels; ++k) shapes_at_level[std::size_t(k)] = t[std::size_t(k)];
+  for (std::size_t i = 0; i < rest.size(); ++i) *rest[i] = t[kLevels + i];
+}
+
+std::int64_t AccuracySummary::shapes() const {
+  std::int64_t n = 0;
+  for (auto s : shapes_at_level) n += s;
+  return n;
+}
+
+nlohmann::json AccuracySummary::json(const config::AccuracyConfig& a) const {
+  const auto n = loads_meeting + loads_exceeding;
+  return {{"rel_l2_bound", a.rel_l2},
+          {"max_level", a.max_level},
+          {"shapes_at_level", shapes_at_level},
+          {"load_cases_meeting", loads_meeting},
+          {"load_cases_exceeding", loads_exceeding},
+          {"share_meeting", n ? double(loads_meeting) / double(n) : 0.0},
+          {"escalations", escalations},
+          {"discarded_load_cases", discarded_loads},
+          {"discarded_newton_iterations", discarded_newton},
+          {"discarded_numeric_factorizations", discarded_factorizations}};
+}
+
+std::string AccuracySummary::line(const config::AccuracyConfig& a) const {
+  if (!a.enabled()) return "";
+  const auto n = loads_meeting + loads_exceeding;
+  std::string levels;
+  for (int k = 0; k <= a.max_level && k < kLevels; ++k)
+    levels += fmt::format("{}{}: {}", k ? ", " : "", k, shapes_at_level[std::size_t(k)]);
+  return fmt::format("  accuracy rel_l2 <= {:g}: {} of {} converged load cases meet it ({:.1f}%); shapes per level "
+                     "{}; {} escalations discarded {} load cases ({} Newton iterations, {} factorisations)\n",
+                     a.rel_l2, loads_meeting, n, n ? 100.0 * double(loads_meeting) / double(n) : 0.0, levels,
+                     escalations, discarded_loads, discarded_newton, discarded_factorizations);
+}
+
+}  // namespace hypershape::factory

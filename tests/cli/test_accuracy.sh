@@ -1,0 +1,125 @@
+#!/usr/bin/env bash
+# Datasets asked for by accuracy (issue 19, config `accuracy: {rel_l2: B}`): a bad block is
+# refused before any work, naming the key; a bound the config's own mesh misses moves every shape
+# up the ladder (P1 -> P2 -> P2 on the mesh refined) until its stored estimates meet it, the
+# level kept recorded per shape (shapes/<id> attributes accuracy_*) and in the run report; a
+# loose bound keeps level 0, whose arrays are those of the same config without the key.
+# Needs HYPERSHAPE_BIN and HYPERSHAPE_SOURCE_DIR (set by CTest).
+. "$(dirname "$0")/lib.sh"
+
+base='preset: random2d
+name: acc
+seed: 7
+shapes: {count: 2, h: 0.1}
+loads: {count: 3}
+representations: {grid_size: 16}'
+
+# Bad values: refused with the key named, nothing written.
+refuse() {  # $1: accuracy block, $2: key the message must name
+  printf '%s\naccuracy: %s\n' "$base" "$1" > "$work/bad.yaml"
+  if "$bin" -q generate "$work/bad.yaml" --progress 0 -o "$work/bad" > "$work/bad.txt" 2>&1; then
+    fail "accuracy: $1 accepted"
+  elif ! grep -q "$2" "$work/bad.txt"; then
+    cat "$work/bad.txt"; fail "accuracy: $1: message does not name $2"
+  elif [ -e "$work/bad" ]; then
+    fail "accuracy: $1: output written before the refusal"
+  else
+    ok "accuracy: $1 refused, naming $2"
+  fi
+}
+refuse '{rel_l2: 0}' 'accuracy.rel_l2'
+refuse '{rel_l2: 1.5}' 'accuracy.rel_l2'
+refuse '{rel_l2: tight}' 'accuracy.rel_l2'
+refuse '{rel_l2: 0.01, max_levle: 2}' 'accuracy.max_levle'
+refuse '{max_level: 2}' 'accuracy.rel_l2'
+refuse '{rel_l2: 0.01, max_level: 9}' 'accuracy.max_level'
+
+# check.py DIR BOUND MIN_LEVEL: every shape's level recorded, >= MIN_LEVEL; its stored estimates
+# meet BOUND or are counted in accuracy_exceeding (only allowed at max_level); the report agrees.
+cat > "$work/check.py" <<'PY'
+import glob, h5py, json, sys
+import numpy as np
+d, bound, min_level = sys.argv[1], float(sys.argv[2]), int(sys.argv[3])
+levels, meeting, exceeding = [], 0, 0
+for f in sorted(glob.glob(f"{d}/shards/*.h5")):
+    with h5py.File(f) as h:
+        for sid, g in h["shapes"].items():
+            a = g.attrs
+            lvl = int(a["accuracy_level"]); levels.append(lvl)
+            assert lvl >= min_level, (sid, lvl)
+            assert int(a["accuracy_degree"]) == (1 if lvl == 0 else 2), (sid, dict(a))
+            n_cell_nodes = g["cells"].shape[1]
+            assert n_cell_nodes == (3 if lvl == 0 else 6), (sid, n_cell_nodes)
+            st = g["loads/status"][...]
+            e = g["loads/error_estimate_rel_l2"][...][st == 1]
+            over = int(((e < 0) | (e > bound)).sum())
+            assert over == int(a["accuracy_exceeding"]), (sid, e, dict(a))
+            assert over == 0 or lvl == 2, (sid, lvl, e)  # only the last level keeps misses
+            assert abs(float(a["accuracy_estimate_max"]) - e.max()) < 1e-12, (sid, e, dict(a))
+            meeting += len(e) - over; exceeding += over
+rep = json.load(open(glob.glob(f"{d}/reports/*.json")[0]))["accuracy"]
+assert rep["shapes_at_level"][:3] == [levels.count(k) for k in range(3)], (rep, levels)
+assert rep["load_cases_meeting"] == meeting and rep["load_cases_exceeding"] == exceeding, (rep, meeting, exceeding)
+print("levels", levels, "meeting", meeting, "exceeding", exceeding, "discarded", rep["discarded_load_cases"])
+PY
+
+# A bound P1 at h 0.1 misses (its estimates are 0.1-0.3): every shape moves to P2 or beyond.
+printf '%s\naccuracy: {rel_l2: 0.05}\n' "$base" > "$work/tight.yaml"
+"$bin" generate "$work/tight.yaml" --progress 0 -o "$work/tight" > "$work/tight.txt" 2>&1 || { cat "$work/tight.txt"; fail "generate (tight)"; }
+/usr/bin/python3 "$work/check.py" "$work/tight" 0.05 1 && ok "rel_l2 0.05: every shape above level 0, estimates meet the bound" \
+  || fail "rel_l2 0.05"
+mpiexec -n 2 "$bin" generate "$work/tight.yaml" --progress 0 -o "$work/tight_np2" > /dev/null 2>&1 || fail "2-rank run (tight)"
+compare "$work/tight" "$work/tight_np2" > "$work/cmp.txt" && ok "2 ranks choose the same levels: the same dataset bit for bit" \
+  || { head -20 "$work/cmp.txt"; fail "2 ranks differ from 1"; }
+grep -q "accuracy rel_l2 <= 0.05" "$work/tight.txt" && ok "printed summary names the bound" || { cat "$work/tight.txt"; fail "summary line"; }
+
+# From P2, one level up is the mesh refined (refine_shape: boundary and patch kept).
+printf '%s\nmesh: {degree: 2}\naccuracy: {rel_l2: 0.02, max_level: 1}\n' "$base" > "$work/refine.yaml"
+"$bin" -q generate "$work/refine.yaml" --progress 0 -o "$work/refine" > "$work/refine.txt" 2>&1 || { cat "$work/refine.txt"; fail "generate (refined)"; }
+/usr/bin/python3 - "$work/refine" <<'PY' && ok "P2 + refinement: level 1 stores the refined mesh, masks on its boundary" || fail "refined level"
+import glob, h5py, sys
+import numpy as np
+n1 = 0
+for f in sorted(glob.glob(f"{sys.argv[1]}/shards/*.h5")):
+    with h5py.File(f) as h:
+        for sid, g in h["shapes"].items():
+            a = g.attrs
+            if int(a["accuracy_level"]) != 1: continue
+            n1 += 1
+            assert abs(a["accuracy_h"] - 0.05) < 1e-12, dict(a)
+            x = g["nodes"][...]; c = g["cells"][...]
+            # P2 on the refined mesh: the areas add up to the drawn polygon's (shoelace)
+            p = x[c[:, :3]]
+            area = 0.5 * np.abs((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1]) - (p[:, 2, 0] - p[:, 0, 0]) * (p[:, 1, 1] - p[:, 0, 1])).sum()
+            assert abs(area - a["measure"]) < 1e-9 * max(1, a["measure"]), (area, a["measure"])
+            dm, nm = g["dirichlet_mask"][...], g["neumann_mask"][...]
+            assert dm.sum() > 0 and nm.sum() > 0 and (g["loads/status"][...] == 1).any()
+assert n1 > 0, "no shape at level 1"
+PY
+
+# A loose bound keeps level 0: the arrays are those of the config without the key (estimates on).
+printf '%s\naccuracy: {rel_l2: 0.9}\n' "$base" > "$work/loose.yaml"
+printf '%s\n' "$base" | sed 's/grid_size: 16}/grid_size: 16, error_estimate: true}/' > "$work/plain.yaml"
+"$bin" -q generate "$work/loose.yaml" --progress 0 -o "$work/loose" > /dev/null 2>&1 || fail "generate (loose)"
+"$bin" -q generate "$work/plain.yaml" --progress 0 -o "$work/plain" > /dev/null 2>&1 || fail "generate (plain)"
+/usr/bin/python3 "$work/check.py" "$work/loose" 0.9 0 > /dev/null || fail "rel_l2 0.9: check"
+/usr/bin/python3 - "$work/loose" "$work/plain" <<'PY' && ok "rel_l2 0.9: level 0 everywhere, arrays identical to the config without accuracy:" \
+  || fail "loose bound differs from no bound"
+import glob, h5py, sys
+import numpy as np
+def arrays(d):
+    out = {}
+    for f in sorted(glob.glob(f"{d}/shards/*.h5")):
+        with h5py.File(f) as h:
+            def visit(name, obj):
+                if isinstance(obj, h5py.Dataset) and name.startswith("shapes/"): out[name] = obj[...]
+            h.visititems(visit)
+            for sid, g in h["shapes"].items():
+                assert g.attrs.get("accuracy_level", 0) == 0
+    return out
+a, b = arrays(sys.argv[1]), arrays(sys.argv[2])
+assert a.keys() == b.keys() and len(a) > 10, (sorted(set(a) ^ set(b)))
+for k in a:
+    assert a[k].shape == b[k].shape and (a[k] == b[k]).all(), k
+PY
+finish

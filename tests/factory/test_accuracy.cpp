@@ -1,0 +1,157 @@
+// Datasets asked for by accuracy (issue 19): the config block, the ladder and its prediction,
+// and refine_shape (the shape on its mesh refined uniformly: same polygon/surface, boundary point i
+// still mesh vertex i, the Dirichlet facets' children exactly the refined facets in the patch).
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <set>
+#include <string>
+
+#include "hypershape/config/dataset.hpp"
+#include "hypershape/core/input_error.hpp"
+#include "hypershape/factory/accuracy.hpp"
+#include "hypershape/factory/dataset_scene.hpp"
+#include "hypershape/geometry/surface_remesh.hpp"
+
+using namespace hypershape;
+
+namespace {
+
+const std::string head = "preset: random2d\nseed: 5\nshapes: {count: 3, h: 0.08}\nloads: {count: 2}\n";
+
+std::string message(const std::string& text) {
+  try {
+    config::parse_dataset_text(text, "<test>");
+  } catch (const core::InputError& e) {
+    return e.what();
+  }
+  return "accepted";
+}
+
+/// Signed area (2D) or volume x 6 (3D) of every cell, summed; and whether all are positive.
+std::pair<double, bool> mesh_measure(const mesh::MeshData& m) {
+  const int d = m.dim, nv = d + 1;
+  double total = 0;
+  bool positive = true;
+  for (std::int64_t c = 0; c < m.n_cells(); ++c) {
+    const int* v = &m.cells[std::size_t(c * nv)];
+    auto x = [&](int a, int k) { return m.coords[std::size_t(v[a] * d + k)] - m.coords[std::size_t(v[0] * d + k)]; };
+    const double s = d == 2 ? x(1, 0) * x(2, 1) - x(1, 1) * x(2, 0)
+                            : x(1, 0) * (x(2, 1) * x(3, 2) - x(2, 2) * x(3, 1)) -
+                                  x(1, 1) * (x(2, 0) * x(3, 2) - x(2, 2) * x(3, 0)) +
+                                  x(1, 2) * (x(2, 0) * x(3, 1) - x(2, 1) * x(3, 0));
+    total += std::abs(s);
+    positive = positive && (s > 0) == (d == 2);  // PETSc: CCW triangles, negative triple product tets
+  }
+  return {total, positive};
+}
+
+/// The boundary's facets are faces of the mesh's cells, and its points are the mesh's first vertices.
+void check_boundary_on_mesh(const factory::ShapeSample& s) {
+  const int d = s.mesh.dim, nv = d + 1;
+  for (std::int64_t i = 0; i < s.boundary.n_points(); ++i)
+    for (int k = 0; k < d; ++k) REQUIRE(s.boundary.point(i)[std::size_t(k)] == s.mesh.coords[std::size_t(i * d + k)]);
+  std::set<std::vector<int>> faces;
+  for (std::int64_t c = 0; c < s.mesh.n_cells(); ++c)
+    for (int skip = 0; skip < nv; ++skip) {
+      std::vector<int> f;
+      for (int a = 0; a < nv; ++a)
+        if (a != skip) f.push_back(s.mesh.cells[std::size_t(c * nv + a)]);
+      std::sort(f.begin(), f.end());
+      faces.insert(f);
+    }
+  for (std::int64_t f = 0; f < s.boundary.n_facets(); ++f) {
+    std::vector<int> v(s.boundary.facet(f).begin(), s.boundary.facet(f).end());
+    std::sort(v.begin(), v.end());
+    REQUIRE(faces.count(v) == 1);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("accuracy: is parsed, validated, implies the estimate and joins the identity only when given",
+          "[factory][accuracy]") {
+  const auto plain = config::parse_dataset_text(head, "<test>");
+  const auto acc = config::parse_dataset_text(head + "accuracy: {rel_l2: 0.01}\n", "<test>");
+  CHECK(!plain.accuracy.enabled());
+  CHECK(acc.accuracy.rel_l2 == 0.01);
+  CHECK(acc.accuracy.max_level == 2);
+  CHECK(acc.representations.error_estimate);
+  CHECK(config::canonical_text(plain).find("accuracy") == std::string::npos);
+  CHECK(config::canonical_text(acc) != config::canonical_text(plain));
+  CHECK(config::canonical_text(config::parse_dataset_text(head + "accuracy: {rel_l2: 0.003}\n", "<test>")) !=
+        config::canonical_text(acc));
+  CHECK_THAT(message(head + "accuracy: {rel_l2: 0}\n"), Catch::Contains("accuracy.rel_l2"));
+  CHECK_THAT(message(head + "accuracy: {rel_l2: 1}\n"), Catch::Contains("accuracy.rel_l2"));
+  CHECK_THAT(message(head + "accuracy: {rel_l2: 0.01, bound: 2}\n"), Catch::Contains("accuracy.bound"));
+  CHECK_THAT(message(head + "accuracy: {rel_l2: 0.01, exceed_share: 0.9}\n"), Catch::Contains("accuracy.exceed_share"));
+  CHECK_THAT(message(head + "accuracy: 0.01\n"), Catch::Contains("accuracy"));
+  CHECK_THAT(message(head + "representations: {error_estimate: false}\naccuracy: {rel_l2: 0.01}\n"),
+             Catch::Contains("representations.error_estimate"));
+}
+
+TEST_CASE("The accuracy ladder and its prediction", "[factory][accuracy]") {
+  auto c = config::parse_dataset_text(head + "accuracy: {rel_l2: 0.01, max_level: 3}\n", "<test>");
+  const auto l0 = factory::accuracy_level(c, 0), l1 = factory::accuracy_level(c, 1), l3 = factory::accuracy_level(c, 3);
+  CHECK((l0.degree == 1 && l0.refinements == 0 && l0.h == 0.08));
+  CHECK((l1.degree == 2 && l1.refinements == 0));
+  CHECK((l3.degree == 2 && l3.refinements == 2 && l3.h == 0.02));
+  CHECK(factory::predicted_reduction(l0, l3) == 40.0);
+  CHECK(factory::next_accuracy_level(c, 0, 0.05) == 1);   // 0.05 / 10 meets 0.01
+  CHECK(factory::next_accuracy_level(c, 0, 0.15) == 2);   // / 20
+  CHECK(factory::next_accuracy_level(c, 0, 5.0) == 3);    // capped at max_level
+  CHECK(factory::next_accuracy_level(c, 1, 0.011) == 2);  // always at least one up
+  CHECK(factory::next_accuracy_level(c, 1, -1) == 2);     // no estimate: one up
+  c.degree = 2;
+  CHECK(factory::accuracy_level(c, 1).refinements == 1);
+}
+
+TEST_CASE("refine_shape keeps the shape, its patch and the boundary-first numbering", "[factory][accuracy]") {
+  const auto c = config::parse_dataset_text(head, "<test>");
+  const auto s = factory::make_shape(factory::shape_config(c, 1), std::nullopt, c.seed, 1);
+  const auto r = factory::refine_shape(s);
+  CHECK(r.mesh.n_cells() == 4 * s.mesh.n_cells());
+  CHECK(r.boundary.n_facets() == 2 * s.boundary.n_facets());
+  CHECK(r.boundary.n_points() == 2 * s.boundary.n_points());
+  const auto [area, positive] = mesh_measure(r.mesh);
+  CHECK(positive);
+  CHECK(area == Approx(mesh_measure(s.mesh).first).epsilon(1e-12));
+  check_boundary_on_mesh(r);
+  // 2D: the polygon in order, counter-clockwise (facet f ends where facet f + 1 starts).
+  for (std::int64_t f = 0; f + 1 < r.boundary.n_facets(); ++f) CHECK(r.boundary.facet(f)[1] == r.boundary.facet(f + 1)[0]);
+  CHECK(r.dirichlet_facets == geometry::facets_in_ball(r.boundary, s.dirichlet_center, s.dirichlet_radius));
+  const auto rr = factory::refine_shape(r);
+  check_boundary_on_mesh(rr);
+  CHECK(rr.dirichlet_facets.size() == 4 * s.dirichlet_facets.size());
+}
+
+TEST_CASE("refine_shape on a tetrahedron: outward facets split in four", "[factory][accuracy]") {
+  factory::ShapeSample s;
+  s.mesh.dim = 3;
+  s.mesh.coords = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+  s.mesh.cells = {0, 2, 1, 3};  // negative triple product (PETSc's orientation)
+  s.boundary.dim = 3;
+  s.boundary.points = s.mesh.coords;
+  s.boundary.facets = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};  // outward
+  s.dirichlet_facets = {2};
+  const auto r = factory::refine_shape(s);
+  CHECK(r.mesh.n_cells() == 8);
+  CHECK(r.boundary.n_facets() == 16);
+  CHECK(r.boundary.n_points() == 10);  // every node of a refined tetrahedron is on its surface
+  CHECK(mesh_measure(r.mesh).second);
+  CHECK(mesh_measure(r.mesh).first == Approx(1.0));
+  check_boundary_on_mesh(r);
+  CHECK(r.dirichlet_facets == std::vector<int>{8, 9, 10, 11});
+  for (std::int64_t f = 0; f < r.boundary.n_facets(); ++f) {  // outward: the normal points away from the centroid
+    const auto v = r.boundary.facet(f);
+    std::array<std::array<double, 3>, 3> x;
+    for (int a = 0; a < 3; ++a)
+      for (int k = 0; k < 3; ++k) x[std::size_t(a)][std::size_t(k)] = r.boundary.point(v[std::size_t(a)])[std::size_t(k)];
+    double e1[3], e2[3], n[3], m[3];
+    for (int k = 0; k < 3; ++k) e1[k] = x[1][k] - x[0][k], e2[k] = x[2][k] - x[0][k], m[k] = x[0][k] - 0.25;
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1], n[1] = e1[2] * e2[0] - e1[0] * e2[2], n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    CHECK(n[0] * m[0] + n[1] * m[1] + n[2] * m[2] > 0);
+  }
+}
