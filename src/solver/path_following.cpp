@@ -136,7 +136,7 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
     // energy line search at that load, and the same fraction of dalpha.
     const double s_full = s_ + dalpha;
     HS_PETSC(VecAXPBYPCZ(du_, 1.0, -dalpha, 0.0, b_, a_));  // Y = -du = b - dalpha a
-    HS_PETSC(VecAXPY(r_, -dalpha, problem_.load()));       // R(u, s + dalpha)
+    HS_PETSC(VecAXPY(r_, -dalpha, problem_.load_at(u_)));  // R(u, s + dalpha)
     const double lambda = backtrack(u_, du_, r_, s_full, w_, b_);
     HS_PETSC(PetscInfo(snes_.get(), "corrector %d: |R| %g (%g to go), |u_k| - d %g, dalpha %g, step %g, %d negative pivots\n", k, rn,
                        rn / (opt_.atol + rtol * std::abs(s_) * fnorm), g, dalpha, lambda, negative_pivots_));
@@ -146,7 +146,7 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
     }
     HS_PETSC(VecCopy(w_, u_));
     s_ += lambda * dalpha;
-    HS_PETSC(VecWAXPY(r_, (1.0 - lambda) * dalpha, problem_.load(), b_));  // R(w, s_)
+    HS_PETSC(VecWAXPY(r_, (1.0 - lambda) * dalpha, problem_.load_at(u_), b_));  // R(w, s_)
     HS_PETSC(VecNorm(r_, NORM_2, &rn));
   }
 }
@@ -245,8 +245,10 @@ TargetResult NonlinearSolver::follow_path(double target, double start, int spent
       // to path_rtol only, where the inertia of a state far from equilibrium would reject
       // good paths (measured: 25 against 13 such failures in 1000 Random2D load cases).
       t.reason = "loss of stability at max|u| = " + std::to_string(d_next) + ", alpha = " +
-                 std::to_string(s_) + ": the tangent has " + std::to_string(negative_pivots_) +
-                 " negative eigenvalue(s) (buckling or a bifurcation)";
+                 std::to_string(s_) + (problem_.conservative() ? ": the tangent has " : ": the symmetric part of the tangent has ") +
+                 std::to_string(negative_pivots_) +
+                 (problem_.conservative() ? " negative eigenvalue(s) (buckling or a bifurcation)"
+                                          : " negative eigenvalue(s) (stability not proven: a follower load)");
       ++t.increments;
       d = d_next;
       break;
