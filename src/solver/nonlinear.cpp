@@ -220,8 +220,9 @@ bool NonlinearSolver::tangent_response(bool guess) {
   negative_pivots_ = -1;
   if (!tangent_->assemble(u_, s_)) return false;
   if (!tangent_->solve(problem_.load_at(u_), a_, guess)) return false;
-  // The inertia of K(u_) is known only from a factor of K(u_) itself.
-  if (tangent_->factor_is_current()) negative_pivots_ = tangent_->negative_eigenvalues();
+  // The inertia of K(u_) is known only from a factor of K(u_) itself. (LU: the symmetric part's,
+  // one more factorisation, is taken at the final state only: correct().)
+  if (tangent_->factor_is_current() && !tangent_->lu()) negative_pivots_ = tangent_->negative_eigenvalues();
   return true;
 }
 

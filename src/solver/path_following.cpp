@@ -98,8 +98,9 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
         why = "tangent factorisation at the final state failed";
         return false;
       }
-      // With multigrid no factor gives the inertia: the smallest eigenvalue's sign does.
-      if (rtol <= opt_.rtol && tangent_->multigrid() && !check_stability_here()) {
+      // With multigrid no factor gives the inertia: the smallest eigenvalue's sign does; with LU
+      // (a follower load) the symmetric part's LDL^T does.
+      if (rtol <= opt_.rtol && (tangent_->multigrid() || tangent_->lu()) && !check_stability_here()) {
         why = "tangent at the final state could not be formed or factorised";
         return false;
       }

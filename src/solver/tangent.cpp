@@ -201,6 +201,7 @@ bool Tangent::multigrid_solve(Vec b, Vec x, bool guess) {
 }
 
 int Tangent::stability(Vec start) {
+  if (lu()) return symmetric_part_inertia();
   set_up_multigrid();
   LogEvent e(events().stability);
   PC pc;

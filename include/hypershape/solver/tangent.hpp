@@ -102,7 +102,8 @@ class Tangent {
   bool apply_factor(Vec x, Vec y);
   /// Inertia of the factor in use; -1 unknown. Exact for K(u) only if factor_is_current().
   /// Non-symmetric K (LU): the negative eigenvalues of (K + K^T)/2 when the factor in use is of
-  /// the assembled K (its LDL^T made on the first call after the factorisation), else -1.
+  /// the assembled K (its LDL^T made on the first call after the factorisation), else -1. The path
+  /// takes it at its final state only (stability()): one LDL^T per target solve.
   int negative_eigenvalues();
   /// The tangent is factorised by LU (a follower load), not by LDL^T.
   bool lu() const { return !problem_.conservative(); }
@@ -110,7 +111,8 @@ class Tangent {
   /// check of a converged state without its factorisation: LOBPCG preconditioned by the AMG
   /// from `start` (overwritten), and, where that does not settle the sign, a factorisation.
   /// Returns 0 (positive definite), >= 1 (indefinite; exact count only if factorised) or -1
-  /// (the factorisation failed). Collective.
+  /// (the factorisation failed). LU kind: the negative eigenvalues of (K + K^T)/2 of the assembled
+  /// K (its LDL^T; `start` unused). Collective.
   int stability(Vec start);
   /// The tangent is solved by AMG-preconditioned Krylov (not by a factorisation).
   bool multigrid() const { return linear_ == LinearSolver::gamg || linear_ == LinearSolver::hypre; }
