@@ -5,12 +5,14 @@
 /// free boundary, and the displacement-controlled path with LU solves reaching a state whose true
 /// residual is within rtol and whose tangent's symmetric part is positive definite.
 #include <catch2/catch.hpp>
+#include <array>
 #include <cmath>
 #include <random>
 
 #include "hypershape/core/error.hpp"
 #include "hypershape/core/vec_array.hpp"
 #include "hypershape/physics/registry.hpp"
+#include "hypershape/physics/tensor.hpp"
 #include "hypershape/solver/nonlinear.hpp"
 #include "support/helpers.hpp"
 
@@ -176,4 +178,57 @@ TEST_CASE("Follower pressure: the stability check counts the negative eigenvalue
   REQUIRE(tangent.solve(b, x, false));
   HS_PETSC(MatMult(tangent.matrix(), x, r));
   CHECK(hstest::rel_diff(r, b) < 1e-10);
+}
+
+TEST_CASE("Follower pressure on a cube on rollers: the homogeneous closed form, dead and follower", "[follower]") {
+  // The unit cube on rollers (u_i = 0 on x_i = 0), pressure p on z = 1: F = diag(a, a, c) with
+  // P_1(a, a, c) = 0 and P_3 = -p (dead) or -p a^2 (follower: the Cauchy stress is -p on the
+  // deformed face, whose area per reference area is a^2). Neo-Hookean principal stresses
+  // P_i = mu (l_i - 1/l_i) + lambda ln J / l_i, solved here by Newton; P1 is exact for it.
+  const double E = 100, nu = 0.3, p = 15;
+  const physics::Lame l = physics::Lame::from_young_poisson(E, nu);
+  auto principal = [&](double li, double J) { return l.mu * (li - 1 / li) + l.lambda * std::log(J) / li; };
+  auto closed_form = [&](bool follower) {
+    double a = 1, c = 1;
+    for (int it = 0; it < 50; ++it) {
+      auto g = [&](double x, double z) {
+        return std::array<double, 2>{principal(x, x * x * z), principal(z, x * x * z) + p * (follower ? x * x : 1.0)};
+      };
+      const auto g0 = g(a, c), ga = g(a + 1e-7, c), gc = g(a, c + 1e-7);
+      const double j11 = (ga[0] - g0[0]) / 1e-7, j12 = (gc[0] - g0[0]) / 1e-7, j21 = (ga[1] - g0[1]) / 1e-7,
+                   j22 = (gc[1] - g0[1]) / 1e-7, det = j11 * j22 - j12 * j21;
+      a -= (j22 * g0[0] - j12 * g0[1]) / det;
+      c -= (-j21 * g0[0] + j11 * g0[1]) / det;
+    }
+    return std::array<double, 2>{a, c};
+  };
+  std::array<double, 2> stretch[2];
+  for (bool follower : {false, true}) {
+    std::vector<physics::EffectPtr> e;
+    e.push_back(physics::make_neo_hookean(E, nu));
+    for (int i = 0; i < 3; ++i) {
+      Vector box{0, 0, 0, 1, 1, 1};
+      box[std::size_t(3 + i)] = 0;
+      e.push_back(physics::make_effect("dirichlet", MapParams({{"box", box}, {"components", Vector{double(i)}}}), 3));
+    }
+    e.push_back(follower ? physics::make_follower_pressure(p, physics::Region::box({0, 0, 1}, {1, 1, 1}), 3)
+                         : physics::make_pressure(p, physics::Region::box({0, 0, 1}, {1, 1, 1}), 3));
+    physics::Problem pb(PETSC_COMM_WORLD, mesh::mesh_box(3, 1.0, 0.5), std::move(e), hstest::degree(1));
+    solver::SolverOptions so;
+    so.rtol = 1e-12;
+    solver::NonlinearSolver ns(pb, so);
+    REQUIRE(ns.solve(1.0).converged);
+    const auto s = stretch[follower] = closed_form(follower);
+    const physics::NodalField f = pb.gather(ns.solution());
+    const auto& X = pb.space().canonical_coords();
+    double err = 0;
+    for (std::size_t k = 0; 3 * k < f.values.size(); ++k)
+      for (int i = 0; i < 3; ++i)
+        err = std::max(err, std::abs(f.values[3 * k + i] - ((i < 2 ? s[0] : s[1]) - 1) * X[3 * k + i]));
+    MPI_Bcast(&err, 1, MPI_DOUBLE, 0, PETSC_COMM_WORLD);
+    INFO((follower ? "follower" : "dead") << ": a = " << s[0] << ", c = " << s[1] << ", max nodal error " << err);
+    CHECK(err < 1e-9);
+  }
+  INFO("c dead " << stretch[0][1] << ", follower " << stretch[1][1]);
+  CHECK(stretch[1][1] < stretch[0][1] - 0.01);  // the face widens: the follower pushes harder
 }
