@@ -55,6 +55,10 @@ Problem::Problem(MPI_Comm comm, const mesh::MeshData& mesh, std::vector<EffectPt
     space_ = std::make_unique<Space>(core::DMH(clone), serial.get(), nullptr, opt, bcs);
   }
   for (auto& e : effects_) e->setup(*space_);
+  for (auto& e : effects_) {
+    has_follower_ = has_follower_ || e->follower();
+    has_scaled_follower_ = has_scaled_follower_ || (e->follower() && e->scaled());
+  }
   HS_PETSC(DMCreateGlobalVector(dm(), load_.out()));
   assemble_load();
 }
@@ -63,17 +67,27 @@ void Problem::assemble_loads(bool scaled, Vec f) const {
   HS_PETSC(VecZeroEntries(f));
   LocalArray fl(dm(), true);
   for (auto& e : effects_)
-    if (e->has_load() && e->active() && e->scaled() == scaled) e->add_load(*space_, fl.array());
+    if (e->has_load() && e->active() && e->scaled() == scaled && !e->follower()) e->add_load(*space_, fl.array());
   fl.release();
   HS_PETSC(DMLocalToGlobal(dm(), fl.vec(), ADD_VALUES, f));
 }
 
 void Problem::assemble_load() {
   assemble_loads(true, load_);
-  HS_PETSC(VecNorm(load_, NORM_2, &load_norm_));
+  if (has_scaled_follower_) {  // the nominal load: f_ext + f_s(0)
+    if (!nominal_) HS_PETSC(VecDuplicate(load_, nominal_.out()));
+    LocalArray fl(dm(), true);
+    for (auto& e : effects_)
+      if (e->follower() && e->active() && e->scaled()) e->add_follower_load(*space_, nullptr, 1.0, fl.array());
+    fl.release();
+    HS_PETSC(VecCopy(load_, nominal_));
+    HS_PETSC(DMLocalToGlobal(dm(), fl.vec(), ADD_VALUES, nominal_));
+  }
+  HS_PETSC(VecNorm(load(), NORM_2, &load_norm_));
   // A fixed load is allocated and assembled only when some effect has one.
-  const bool any_fixed = std::any_of(effects_.begin(), effects_.end(),
-                                     [](const EffectPtr& e) { return e->has_load() && !e->scaled(); });
+  const bool any_fixed = std::any_of(effects_.begin(), effects_.end(), [](const EffectPtr& e) {
+    return e->has_load() && !e->scaled() && !e->follower();
+  });
   if (!any_fixed) return;
   if (!fixed_load_) HS_PETSC(DMCreateGlobalVector(dm(), fixed_load_.out()));
   assemble_loads(false, fixed_load_);
@@ -99,6 +113,47 @@ void Problem::to_local(Vec u, Vec ul) const {
   HS_PETSC(DMGlobalToLocal(dm(), u, INSERT_VALUES, ul));
 }
 
+void Problem::add_follower_loads(const PetscScalar* u, double load_factor, PetscScalar* r) const {
+  for (auto& e : effects_)
+    if (e->follower() && e->active()) e->add_follower_load(*space_, u, -(e->scaled() ? load_factor : 1.0), r);
+}
+
+void Problem::add_follower_force(Vec u, double scaled_weight, double fixed_weight, Vec f) const {
+  LocalArray ul(dm(), false), fl(dm(), true);
+  to_local(u, ul.vec());
+  for (auto& e : effects_)
+    if (e->follower() && e->active())
+      e->add_follower_load(*space_, ul.array(), e->scaled() ? scaled_weight : fixed_weight, fl.array());
+  fl.release();
+  HS_PETSC(DMLocalToGlobal(dm(), fl.vec(), ADD_VALUES, f));
+}
+
+Vec Problem::load_at(Vec u) const {
+  if (!has_scaled_follower_) return load_.get();
+  if (!load_at_) HS_PETSC(VecDuplicate(load_, load_at_.out()));
+  HS_PETSC(VecCopy(load_, load_at_));
+  add_follower_force(u, 1.0, 0.0, load_at_);
+  return load_at_.get();
+}
+
+bool Problem::energy_along(Vec from, Vec to, double load_factor, double& value) const {
+  const bool ok = energy(to, load_factor, value);
+  if (!ok || !has_follower_) return ok;
+  for (auto& v : along_)
+    if (!v) HS_PETSC(VecDuplicate(load_, v.out()));
+  Vec d = along_[0], mid = along_[1], f = along_[2];
+  HS_PETSC(VecWAXPY(d, -1.0, from, to));
+  HS_PETSC(VecWAXPY(mid, 0.5, d, from));
+  HS_PETSC(VecZeroEntries(f));  // Simpson: (f(from) + 4 f(mid) + f(to)) / 6
+  add_follower_force(from, load_factor / 6, 1.0 / 6, f);
+  add_follower_force(mid, 4 * load_factor / 6, 4.0 / 6, f);
+  add_follower_force(to, load_factor / 6, 1.0 / 6, f);
+  PetscScalar work;
+  HS_PETSC(VecDot(f, d, &work));
+  value -= PetscRealPart(work);
+  return true;
+}
+
 bool Problem::energy(Vec u, double load_factor, double& value) const {
   LocalArray ul(dm(), false);
   to_local(u, ul.vec());
@@ -121,6 +176,7 @@ bool Problem::residual(Vec u, double load_factor, Vec r) const {
   bool ok = true;
   for (auto& eff : effects_)
     if (eff->has_energy()) ok = ok && eff->add_residual(*space_, ul.array(), rl.array());
+  if (has_follower_) add_follower_loads(ul.array(), load_factor, rl.array());
   ok = all_ranks(comm(), ok);
   rl.release();
   HS_PETSC(VecZeroEntries(r));
@@ -130,13 +186,16 @@ bool Problem::residual(Vec u, double load_factor, Vec r) const {
   return ok;
 }
 
-bool Problem::jacobian(Vec u, Mat J) const {
+bool Problem::jacobian(Vec u, Mat J, double load_factor) const {
   LocalArray ul(dm(), false);
   to_local(u, ul.vec());
   HS_PETSC(MatZeroEntries(J));
   bool ok = true;
-  for (auto& eff : effects_)
+  for (auto& eff : effects_) {
     if (eff->has_energy()) ok = ok && eff->add_jacobian(*space_, ul.array(), J);
+    if (eff->follower() && eff->active())
+      eff->add_follower_jacobian(*space_, ul.array(), eff->scaled() ? load_factor : 1.0, J);
+  }
   HS_PETSC(MatAssemblyBegin(J, MAT_FINAL_ASSEMBLY));
   HS_PETSC(MatAssemblyEnd(J, MAT_FINAL_ASSEMBLY));
   return all_ranks(comm(), ok);
@@ -174,7 +233,10 @@ Resultants Problem::resultants(Vec u, double load_factor) const {
     // external force on the body, kept apart so that the balance closes (spring_force).
     if (eff->has_energy())
       ok = ok && eff->add_residual(*space_, ul.array(), eff->is_material() ? fi.array() : fs.array());
-    if (eff->has_load() && eff->active()) eff->add_load(*space_, eff->scaled() ? fe.array() : ff.array());
+    // A follower load acts with its force at the state.
+    if (eff->has_load() && eff->active() && eff->follower())
+      eff->add_follower_load(*space_, ul.array(), 1.0, eff->scaled() ? fe.array() : ff.array());
+    else if (eff->has_load() && eff->active()) eff->add_load(*space_, eff->scaled() ? fe.array() : ff.array());
   }
   Resultants out;
   out.admissible = all_ranks(comm(), ok);
@@ -305,6 +367,7 @@ core::MatH Problem::create_matrix() const {
   if (!pattern_) HS_PETSC(DMCreateMatrix(dm(), pattern_.out()));
   core::MatH J;
   HS_PETSC(MatDuplicate(pattern_, MAT_DO_NOT_COPY_VALUES, J.out()));
+  if (!conservative()) return J;  // a follower load's stiffness is not symmetric
   HS_PETSC(MatSetOption(J, MAT_SYMMETRIC, PETSC_TRUE));
   HS_PETSC(MatSetOption(J, MAT_SYMMETRY_ETERNAL, PETSC_TRUE));
   return J;

@@ -377,7 +377,7 @@ bool timed(double& acc, F&& f) {
 double TwoLevelEstimator::fine_step(Vec x, Vec r, double alpha, bool first, bool& fell_back, ErrorEstimate& out) const {
   Vec dx = fv_[2], w = fv_[3];
   out.tangent_assemblies += 1;
-  if (!timed(out.seconds_assembly, [&] { return fine_.jacobian(x, Kf_); })) return -1;
+  if (!timed(out.seconds_assembly, [&] { return fine_.jacobian(x, Kf_, alpha); })) return -1;
   HS_PETSC(KSPSetOperators(ksp_, Kf_, Kf_));
   HS_PETSC(VecScale(r, -1.0));
   timed(out.seconds_linear, [&] {
@@ -485,7 +485,7 @@ bool TwoLevelEstimator::prepare_coarse(Vec u_h, const CoarseSolve& coarse_solve,
   if (!direct_) {
     HS_PETSC(KSPCreate(comm, direct_.out()));
     HS_PETSC(KSPSetOptionsPrefix(direct_, "error_estimate_coarse_"));
-    configure_direct_solver(direct_, comm, coarse_.space().dim());
+    configure_direct_solver(direct_, comm, coarse_.space().dim(), coarse_.conservative());
   }
   HS_PETSC(KSPSetOperators(direct_, Kc_, Kc_));  // new values: a numeric refactorisation
   out.factorizations = 1;

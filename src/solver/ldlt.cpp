@@ -62,11 +62,11 @@ int negative_eigenvalues(KSP ksp) {
   return int(neg);
 }
 
-void configure_direct_solver(KSP ksp, MPI_Comm comm, int dim) {
+void configure_direct_solver(KSP ksp, MPI_Comm comm, int dim, bool symmetric) {
   PC pc;
   HS_PETSC(KSPSetType(ksp, KSPPREONLY));
   HS_PETSC(KSPGetPC(ksp, &pc));
-  HS_PETSC(PCSetType(pc, PCCHOLESKY));
+  HS_PETSC(PCSetType(pc, symmetric ? PCCHOLESKY : PCLU));
   // 2D on one rank: PETSc's own sparse Cholesky (LDL^T without pivoting); measured 1.4x faster
   // per load case than MUMPS on Random2D shapes, whose per-call overhead dominates at a few
   // thousand unknowns. In 3D its non-supernodal factorisation is far slower than MUMPS (a
@@ -76,7 +76,7 @@ void configure_direct_solver(KSP ksp, MPI_Comm comm, int dim) {
   MPI_Comm_size(comm, &ranks);
   if (ranks == 1 && dim == 2) {
     HS_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERPETSC));
-    HS_PETSC(PCFactorSetMatOrderingType(pc, MATORDERINGQMD));
+    HS_PETSC(PCFactorSetMatOrderingType(pc, symmetric ? MATORDERINGQMD : MATORDERINGND));
   } else {
     HS_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
   }
@@ -97,15 +97,16 @@ core::KSPH make_factor_preconditioned_gmres(MPI_Comm comm, void* ctx, PetscError
   return ksp;
 }
 
-LdltFactor::LdltFactor(const physics::Problem& problem, const std::string& prefix) {
+LdltFactor::LdltFactor(const physics::Problem& problem, const std::string& prefix, bool symmetric)
+    : symmetric_(symmetric) {
   HS_PETSC(KSPCreate(problem.comm(), ksp_.out()));
   if (!prefix.empty()) HS_PETSC(KSPSetOptionsPrefix(ksp_, prefix.c_str()));
-  configure_direct_solver(ksp_, problem.comm(), problem.space().dim());
+  configure_direct_solver(ksp_, problem.comm(), problem.space().dim(), symmetric);
   // The blocked kind where PETSc's own factorisation is used and no option asks for another
   // (the options keep their meaning: the general kind reads them).
   PetscMPIInt ranks;
   MPI_Comm_size(problem.comm(), &ranks);
-  blocked_ = ranks == 1 && problem.space().dim() == 2 && !option_given(prefix, "-pc_factor_mat_solver_type") &&
+  blocked_ = symmetric && ranks == 1 && problem.space().dim() == 2 && !option_given(prefix, "-pc_factor_mat_solver_type") &&
              !option_given(prefix, "-pc_factor_mat_ordering_type") && !option_given(prefix, "-pc_type") &&
              !option_given(prefix, "-ksp_type");
   if (blocked_) {
@@ -226,8 +227,8 @@ bool LdltFactor::factorise(Mat A) {
   analysed_ = true;
   if (!blocked_ && !F_) {
     HS_PETSC(MatDuplicate(A, MAT_DO_NOT_COPY_VALUES, F_.out()));
-    HS_PETSC(MatSetOption(F_, MAT_SYMMETRIC, PETSC_TRUE));
-    HS_PETSC(MatSetOption(F_, MAT_SYMMETRY_ETERNAL, PETSC_TRUE));
+    HS_PETSC(MatSetOption(F_, MAT_SYMMETRIC, symmetric_ ? PETSC_TRUE : PETSC_FALSE));
+    HS_PETSC(MatSetOption(F_, MAT_SYMMETRY_ETERNAL, symmetric_ ? PETSC_TRUE : PETSC_FALSE));
   }
   if (blocked_) scatter_values(A);
   else HS_PETSC(MatCopy(A, F_, SAME_NONZERO_PATTERN));

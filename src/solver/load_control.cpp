@@ -100,12 +100,12 @@ double NonlinearSolver::linear_response() {
 std::optional<double> NonlinearSolver::linear_response(Vec du) {
   HS_PETSC(VecCopy(u_, backup_));
   ++snes_linear_.tangent_assemblies;
-  if (!problem_.jacobian(u_, J_)) return std::nullopt;
+  if (!problem_.jacobian(u_, J_, s_)) return std::nullopt;
   ++snes_linear_.numeric_factorizations;
   KSP ksp;
   HS_PETSC(SNESGetKSP(snes_, &ksp));
   HS_PETSC(KSPSetOperators(ksp, J_, J_));
-  HS_PETSC(KSPSolve(ksp, problem_.load(), du));
+  HS_PETSC(KSPSolve(ksp, problem_.load_at(u_), du));
   return problem_.max_displacement(du);
 }
 

@@ -68,7 +68,7 @@ NonlinearSolver::NonlinearSolver(const physics::Problem& problem, const SolverOp
   HS_PETSC(SNESSetTolerances(snes_, opt.atol, 1e-50, 0.0, opt.max_newton, -1));
   KSP ksp;
   HS_PETSC(SNESGetKSP(snes_, &ksp));
-  configure_direct_solver(ksp, problem.comm(), problem.space().dim());
+  configure_direct_solver(ksp, problem.comm(), problem.space().dim(), problem.conservative());
   HS_PETSC(SNESSetFromOptions(snes_));
   const char* ksp_prefix = nullptr;
   HS_PETSC(KSPGetOptionsPrefix(ksp, &ksp_prefix));
@@ -95,7 +95,7 @@ PetscErrorCode NonlinearSolver::form_jacobian(SNES snes, Vec x, Mat, Mat P, void
   auto* self = static_cast<NonlinearSolver*>(ctx);
   return guarded([&] {
     ++self->snes_linear_.tangent_assemblies;
-    if (!self->problem_.jacobian(x, P)) HS_PETSC(SNESSetJacobianDomainError(snes));
+    if (!self->problem_.jacobian(x, P, self->s_eval_)) HS_PETSC(SNESSetJacobianDomainError(snes));
     else ++self->snes_linear_.numeric_factorizations;  // the SNES's KSP factorises it next
   });
 }
@@ -133,6 +133,7 @@ double NonlinearSolver::backtrack(Vec X, Vec Y, Vec F, double s, Vec W, Vec G) {
   // Newton step: W = X - lambda Y. Backtrack from lambda = 1 until W is admissible (det F > 0
   // everywhere: finite energy) and either the energy decreases (Armijo) or, where the tangent
   // is not positive definite or the energy change is below round-off, the residual norm does.
+  // (With a follower load there is no energy: Problem::energy_along, whose slope is the same.)
   PetscReal fnorm0, slope;
   HS_PETSC(VecNorm(F, NORM_2, &fnorm0));
   HS_PETSC(VecDot(F, Y, &slope));
@@ -144,7 +145,7 @@ double NonlinearSolver::backtrack(Vec X, Vec Y, Vec F, double s, Vec W, Vec G) {
   for (int it = 0; it < 40 && lambda > 1e-10; ++it) {
     HS_PETSC(VecWAXPY(W, -lambda, Y, X));
     double e;
-    if (!problem_.energy(W, s, e)) {  // inadmissible: never accept, halve
+    if (!problem_.energy_along(X, W, s, e)) {  // inadmissible: never accept, halve
       lambda *= 0.5;
       continue;
     }
@@ -173,7 +174,7 @@ TargetResult NonlinearSolver::solve_for_target(double target) {
   const std::string first = t.reason;
   int switches = 0;
   for (; switches < opt_.branch_switches && opt_.control == Control::displacement && !t.converged &&
-         target > 0 && t.solves > 0 && t.newton_iterations < opt_.newton_budget;
+         target > 0 && t.solves > 0 && t.newton_iterations < opt_.newton_budget && problem_.conservative();
        ++switches)
     switch_branch(target, start, switches, t);
   // A fold verified on the path from rest (follow_path) stays the reason where no switch found
@@ -181,6 +182,8 @@ TargetResult NonlinearSolver::solve_for_target(double target) {
   if (!t.converged && switches > 0 && first.rfind("fold:", 0) == 0)
     t.reason = first + "; " + std::to_string(switches) + " branch switch(es) found no stable state on target (last: " +
                t.reason.substr(0, 400) + ")";
+  if (!t.converged && !problem_.conservative() && opt_.branch_switches > 0 && opt_.control == Control::displacement)
+    t.reason += "; no branch switch: a follower load has no energy to minimise";
   if (opt_.control == Control::displacement && !t.converged && opt_.fallback && target > 0) {
     // Fallback, measured on Random2D draws: where the path cannot be followed (Newton stalls
     // next to a bifurcation), load-controlled solves from the last converged state of the
@@ -216,30 +219,31 @@ bool NonlinearSolver::apply_tangent_factor(Vec x, Vec y) {
 bool NonlinearSolver::rest_response() {
   if (!tangent_->use_rest_factor(u_)) return tangent_response(false);
   negative_pivots_ = -1;
-  if (!tangent_->apply_factor(problem_.load(), a_)) return false;
+  if (!tangent_->apply_factor(problem_.load_at(u_), a_)) return false;
   negative_pivots_ = tangent_->negative_eigenvalues();
   return true;
 }
 
 bool NonlinearSolver::tangent_response(bool guess) {
   negative_pivots_ = -1;
-  if (!tangent_->assemble(u_)) return false;
-  if (!tangent_->solve(problem_.load(), a_, guess)) return false;
-  // The inertia of K(u_) is known only from a factor of K(u_) itself.
-  if (tangent_->factor_is_current()) negative_pivots_ = tangent_->negative_eigenvalues();
+  if (!tangent_->assemble(u_, s_)) return false;
+  if (!tangent_->solve(problem_.load_at(u_), a_, guess)) return false;
+  // The inertia of K(u_) is known only from a factor of K(u_) itself. (LU: the symmetric part's,
+  // one more factorisation, is taken at the final state only: correct().)
+  if (tangent_->factor_is_current() && !tangent_->lu()) negative_pivots_ = tangent_->negative_eigenvalues();
   return true;
 }
 
 bool NonlinearSolver::factorise_here() {
   negative_pivots_ = -1;
-  if (!tangent_->assemble(u_) || !tangent_->factorise()) return false;
+  if (!tangent_->assemble(u_, s_) || !tangent_->factorise()) return false;
   negative_pivots_ = tangent_->negative_eigenvalues();
   return true;
 }
 
 bool NonlinearSolver::check_stability_here() {
   negative_pivots_ = -1;
-  if (!tangent_->assemble(u_)) return false;
+  if (!tangent_->assemble(u_, s_)) return false;
   pseudo_random_vector(v_);
   negative_pivots_ = tangent_->stability(v_);
   return negative_pivots_ >= 0;

@@ -32,8 +32,13 @@ struct LoadExtremes {
 /// negative and max|u| falls as the load rises: the path (one state per max|u|, continuous)
 /// passed a limit point of the load between its start and the target, and its one state with
 /// max|u| = target is unstable: no stable equilibrium on target is on this path.
-std::string unstable_reason(double target, double alpha, int negative, double slope, const LoadExtremes& e) {
+std::string unstable_reason(double target, double alpha, int negative, double slope, const LoadExtremes& e,
+                            bool conservative) {
   auto num = [](double x) { return std::to_string(x); };
+  if (!conservative)
+    return "loss of stability at max|u| = " + num(target) + ", alpha = " + num(alpha) +
+           ": the symmetric part of the tangent has " + std::to_string(negative) +
+           " negative eigenvalue(s) (stability not proven: a follower load)";
   if (negative == 1 && slope < 0)
     return "fold: max|u| = target lies on an unstable segment of the path (at max|u| = " + num(target) +
            ", alpha = " + num(alpha) + ": d max|u| / d alpha = " + num(slope) +
@@ -130,8 +135,9 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
         why = "tangent factorisation at the final state failed";
         return false;
       }
-      // With multigrid no factor gives the inertia: the smallest eigenvalue's sign does.
-      if (rtol <= opt_.rtol && tangent_->multigrid() && !check_stability_here()) {
+      // With multigrid no factor gives the inertia: the smallest eigenvalue's sign does; with LU
+      // (a follower load) the symmetric part's LDL^T does.
+      if (rtol <= opt_.rtol && (tangent_->multigrid() || tangent_->lu()) && !check_stability_here()) {
         why = "tangent at the final state could not be formed or factorised";
         return false;
       }
@@ -168,7 +174,7 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
     // energy line search at that load, and the same fraction of dalpha.
     const double s_full = s_ + dalpha;
     HS_PETSC(VecAXPBYPCZ(du_, 1.0, -dalpha, 0.0, b_, a_));  // Y = -du = b - dalpha a
-    HS_PETSC(VecAXPY(r_, -dalpha, problem_.load()));       // R(u, s + dalpha)
+    HS_PETSC(VecAXPY(r_, -dalpha, problem_.load_at(u_)));  // R(u, s + dalpha)
     const double lambda = backtrack(u_, du_, r_, s_full, w_, b_);
     HS_PETSC(PetscInfo(snes_.get(), "corrector %d: |R| %g (%g to go), |u_k| - d %g, dalpha %g, step %g, %d negative pivots\n", k, rn,
                        rn / (opt_.atol + rtol * std::abs(s_) * fnorm), g, dalpha, lambda, negative_pivots_));
@@ -178,7 +184,7 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
     }
     HS_PETSC(VecCopy(w_, u_));
     s_ += lambda * dalpha;
-    HS_PETSC(VecWAXPY(r_, (1.0 - lambda) * dalpha, problem_.load(), b_));  // R(w, s_)
+    HS_PETSC(VecWAXPY(r_, (1.0 - lambda) * dalpha, problem_.load_at(u_), b_));  // R(w, s_)
     HS_PETSC(VecNorm(r_, NORM_2, &rn));
   }
 }
@@ -279,16 +285,17 @@ TargetResult NonlinearSolver::follow_path(double target, double start, int spent
       // to path_rtol only, where the inertia of a state far from equilibrium would reject
       // good paths (measured: 25 against 13 such failures in 1000 Random2D load cases).
       // Judged and classified on this state's own tangent (the corrector's last factor is one
-      // Newton step older): its inertia and d max|u| / d alpha = c . K^-1 f_ext.
+      // Newton step older): its inertia and d max|u| / d alpha = c . K^-1 f_ext. A follower load
+      // keeps the check of its tangent's symmetric part (no energy, no fold to classify).
       const int older = negative_pivots_;
       PetscReal slope = 0;
-      if (factorise_here() && tangent_->apply_factor(problem_.load(), w_)) {
+      if (problem_.conservative() && factorise_here() && tangent_->apply_factor(problem_.load(), w_)) {
         control_direction(u_, w_, c_);
         HS_PETSC(VecDot(c_, w_, &slope));
       }
       if (negative_pivots_ < 0) negative_pivots_ = older;
       if (negative_pivots_ > 0) {
-        t.reason = unstable_reason(d_next, s_, negative_pivots_, slope, extremes);
+        t.reason = unstable_reason(d_next, s_, negative_pivots_, slope, extremes, problem_.conservative());
         ++t.increments;
         d = d_next;
         break;

@@ -40,8 +40,11 @@ Tangent::Tangent(const physics::Problem& problem, const TangentOptions& opt, con
   if (opt_.krylov_budget <= 0) opt_.krylov_budget = problem.space().dim() == 2 ? 25 : 60;
   forcing_ = opt_.krylov_rtol;
   J_ = problem.create_matrix();
-  // A kept factor is the direct solver's: with factor reuse, auto means direct.
-  linear_ = opt_.reuse && opt_.linear == LinearSolver::automatic
+  // A kept factor is the direct solver's: with factor reuse, auto means direct. A follower
+  // load's tangent is not symmetric (CG and the stability check by LOBPCG need it so): direct.
+  if (lu() && opt_.linear != LinearSolver::automatic && opt_.linear != LinearSolver::direct)
+    throw std::invalid_argument("a follower load's tangent is not symmetric: the linear solver must be direct (LU)");
+  linear_ = (opt_.reuse || lu()) && opt_.linear == LinearSolver::automatic
                 ? LinearSolver::direct
                 : resolve_linear_solver(opt_.linear, problem.space().dim(), problem.space().n_dofs_global(), opt_.auto_dofs);
   if (multigrid()) {
@@ -49,7 +52,7 @@ Tangent::Tangent(const physics::Problem& problem, const TangentOptions& opt, con
     set_rigid_body_near_null_space(problem, J_);
     amg_ = make_multigrid_ksp(problem.comm(), linear_, prefix);
   }
-  work_ = std::make_unique<LdltFactor>(problem, prefix);
+  work_ = std::make_unique<LdltFactor>(problem, prefix, !lu());
   krylov_ = make_factor_preconditioned_gmres(problem.comm(), this, apply_shell, "kept LDL^T factor of an earlier tangent");
   HS_PETSC(KSPSetOptionsPrefix(krylov_, (prefix + "tangent_").c_str()));
   HS_PETSC(KSPGMRESSetRestart(krylov_, 40));
@@ -70,17 +73,19 @@ PetscErrorCode Tangent::apply_shell(PC pc, Vec x, Vec y) {
   PetscFunctionReturn(0);
 }
 
-bool Tangent::assemble(Vec u) {
+bool Tangent::assemble(Vec u, double s) {
   LogEvent e(events().tangent_assembly);
   current_ = false;
   amg_current_ = false;
+  symmetric_negative_ = -2;
   ++n_.tangent_assemblies;
-  return problem_.jacobian(u, J_);
+  return problem_.jacobian(u, J_, s);
 }
 
 void Tangent::shift(double mu) {
   current_ = false;
   amg_current_ = false;
+  symmetric_negative_ = -2;
   HS_PETSC(MatShift(J_, mu));
 }
 
@@ -95,7 +100,7 @@ bool Tangent::factorise() {
 }
 
 bool Tangent::use_rest_factor(Vec rest) {
-  if (problem_.space().dim() != 2) return false;
+  if (problem_.space().dim() != 2 || lu()) return false;
   if (!rest_) {
     LogEvent e(events().factorisation);
     J0_ = problem_.create_matrix();
@@ -120,7 +125,35 @@ bool Tangent::apply_factor(Vec x, Vec y) {
   return factor().solve(x, y);
 }
 
-int Tangent::negative_eigenvalues() const { return factor().negative_eigenvalues(); }
+int Tangent::negative_eigenvalues() {
+  if (!lu()) return factor().negative_eigenvalues();
+  return current_ ? symmetric_part_inertia() : -1;
+}
+
+int Tangent::symmetric_part_inertia() {
+  if (symmetric_negative_ != -2) return symmetric_negative_;
+  LogEvent e(events().stability);
+  // S = (K + K^T)/2 on K's pattern (structurally symmetric: K^T has the same one).
+  if (Kt_) {
+    Mat kt = Kt_;
+    HS_PETSC(MatTranspose(J_, MAT_REUSE_MATRIX, &kt));
+  } else {
+    HS_PETSC(MatTranspose(J_, MAT_INITIAL_MATRIX, Kt_.out()));
+  }
+  if (!S_) {
+    HS_PETSC(MatDuplicate(J_, MAT_DO_NOT_COPY_VALUES, S_.out()));
+    HS_PETSC(MatSetOption(S_, MAT_SYMMETRIC, PETSC_TRUE));
+    HS_PETSC(MatSetOption(S_, MAT_SYMMETRY_ETERNAL, PETSC_TRUE));
+    symmetric_part_ = std::make_unique<LdltFactor>(problem_, prefix_ + "stability_");
+    ++n_.symbolic_factorizations;
+  }
+  HS_PETSC(MatCopy(J_, S_, SAME_NONZERO_PATTERN));
+  HS_PETSC(MatAXPY(S_, 1.0, Kt_, SUBSET_NONZERO_PATTERN));
+  HS_PETSC(MatScale(S_, 0.5));
+  ++n_.numeric_factorizations;
+  symmetric_negative_ = symmetric_part_->factorise(S_) ? symmetric_part_->negative_eigenvalues() : -1;
+  return symmetric_negative_;
+}
 
 KSPConvergedReason Tangent::run_krylov(KSP ksp, Vec b, Vec x, bool guess, int max_its, PetscInt& its) {
   // Relative to ||b|| also with an initial guess (PETSc's default test would take the guess's
@@ -168,6 +201,7 @@ bool Tangent::multigrid_solve(Vec b, Vec x, bool guess) {
 }
 
 int Tangent::stability(Vec start) {
+  if (lu()) return symmetric_part_inertia();
   set_up_multigrid();
   LogEvent e(events().stability);
   PC pc;

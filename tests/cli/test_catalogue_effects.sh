@@ -7,6 +7,7 @@
 #    drawn value at the Neumann nodes) stored; the torch Dataset serves them;
 #  - `hypershape solve` on the disk with each new material and load converges; Cook's membrane
 #    (configs/scenes/cook_membrane.yaml) at h = 2 near the literature's u_y(48, 60);
+#  - the follower pressure's scene converges;
 #  - bad keys stop before any work: exit code 2, the key named.
 . "$(dirname "$0")/lib.sh"
 export PYTHONPATH="$src/scripts${PYTHONPATH:+:$PYTHONPATH}"
@@ -60,6 +61,11 @@ scene "  neo_hookean: {E: 500, nu: 0.4}
   uniform_traction: {value: [0.0, -1.0], box: [-1.0, -1.0, -0.5, 1.0], scale: fixed}" "load: {target: 0.1}" > "$work/s.yaml"
 "$bin" -q solve "$work/s.yaml" -o "$work/s.h5" >/dev/null 2>&1 && ok "solve: pressure + uniform_traction" || fail "solve: loads"
 
+# The follower pressure's scene (a cantilever, the pressure on its top face turning with it): LU
+# solves, converged to max|u| = 2.
+"$bin" -q solve "$src/configs/scenes/follower_pressure.yaml" -o "$work/f.h5" >/dev/null 2>&1 \
+  && ok "solve: follower pressure (configs/scenes/follower_pressure.yaml)" || fail "solve: follower pressure"
+
 # Cook's membrane (a polygon scene, a clamped edge, a shear traction on an edge) at h = 2, P2:
 # u_y(48, 60) within 0.6% of the literature's 6.9083 (measured 6.8822, -0.38%).
 sed 's/mesh: {h: 1.0, degree: 2}/mesh: {h: 2.0, degree: 2}/' "$src/configs/scenes/cook_membrane.yaml" > "$work/cook.yaml"
@@ -94,6 +100,8 @@ bad '  neo_hookean: {E: 500, nu: 0.3}
   pressure: {value: 1, box: [0, 0, 1]}' 'effects.pressure.box'
 bad '  neo_hookean: {E: 500, nu: 0.3}
   dirichlet: {components: [0]}' 'effects.dirichlet.box'
+bad '  neo_hookean: {E: 500, nu: 0.3}
+  pressure: {value: 1, follower: yes}' 'effects.pressure.follower'
 printf 'geometry: {polygon: [[0, 0], [1, 0]]}\nmesh: {h: 0.1}\neffects:\n  linear_elastic: {E: 1, nu: 0.3}\n  dirichlet: {box: [0, 0, 0, 1]}\nload: {alpha: 1}\n' > "$work/bad.yaml"
 out=$("$bin" -q solve "$work/bad.yaml" -o "$work/bad.h5" 2>&1); rc=$?
 [ $rc -eq 2 ] && grep -q "geometry.polygon" <<<"$out" && ok "rejected: geometry.polygon" || fail "bad polygon (rc $rc): $out"

@@ -50,6 +50,11 @@ TEST_CASE("Catalogue effects have the same solution on any number of ranks", "[m
       {"neo_hookean with a modulus field", [field] { return scene(physics::make_neo_hookean(500, 0.4, field), traction()); }},
       {"pressure on a ball region",
        [] { return scene(physics::make_neo_hookean(500, 0.4), physics::make_pressure(1.0, physics::Region::ball({-1, 0}, 0.8), 2)); }},
+      {"follower pressure on a ball region (issue 18: LU solves)",
+       [] {
+         return scene(physics::make_neo_hookean(500, 0.4),
+                      physics::make_follower_pressure(1.0, physics::Region::ball({-1, 0}, 0.8), 2));
+       }},
       {"uniform traction on a box region",
        [] {
          return scene(physics::make_neo_hookean(500, 0.4),
@@ -89,4 +94,43 @@ TEST_CASE("Catalogue effects have the same solution on any number of ranks", "[m
       CHECK(rel < 1e-9);
     }
   }
+}
+
+TEST_CASE("A follower pressure's displacement-controlled path is the same on any number of ranks", "[mpi][effects][follower]") {
+  // Not conservative (pressure on part of a free boundary): LU solves (PETSc's on one rank, MUMPS
+  // on several), the residual line search, the symmetric part's inertia as the stability check.
+  auto run = [](MPI_Comm comm, double& alpha, bool& converged, double& residual) {
+    mesh::MeshData m;
+    if (core::rank(comm) == 0) m = hstest::disk_mesh(0.1);
+    physics::Problem p(comm, m,
+                       scene(physics::make_neo_hookean(500, 0.4),
+                             physics::make_follower_pressure(1.0, physics::Region::ball({-1, 0}, 0.8), 2)),
+                       hstest::degree(1));
+    solver::NonlinearSolver ns(p);
+    const solver::TargetResult t = ns.solve_for_target(0.15);
+    converged = t.converged && t.negative_pivots == 0;
+    alpha = t.alpha;
+    core::VecH r = p.create_vector();
+    p.residual(ns.solution(), t.alpha, r);
+    PetscReal rn;
+    HS_PETSC(VecNorm(r, NORM_2, &rn));
+    residual = rn / (t.alpha * p.load_norm());
+    return p.gather(ns.solution()).values;
+  };
+  double alpha_ref = 0, alpha = 0, res_ref = 0, res = 0;
+  bool ok_ref = false, ok = false;
+  std::vector<double> ref;
+  if (core::rank(PETSC_COMM_WORLD) == 0) ref = run(PETSC_COMM_SELF, alpha_ref, ok_ref, res_ref);
+  const std::vector<double> u = run(PETSC_COMM_WORLD, alpha, ok, res);
+  double d = 0, scale = 0;
+  for (std::size_t i = 0; i < ref.size() && i < u.size(); ++i)
+    d = std::max(d, std::abs(u[i] - ref[i])), scale = std::max(scale, std::abs(ref[i]));
+  const double rel = broadcast(core::rank(PETSC_COMM_WORLD) == 0 && u.size() == ref.size() ? d / scale : 1.0);
+  INFO("ranks " << core::size(PETSC_COMM_WORLD) << ": alpha " << alpha << " (one rank " << broadcast(alpha_ref)
+                << "), true residual / (alpha |f|) " << res << ", relative difference in u " << rel);
+  CHECK(broadcast(ok_ref) == 1.0);
+  CHECK(ok);
+  CHECK(res <= 1e-9);
+  CHECK(rel < 1e-9);
+  CHECK(std::abs(alpha / broadcast(alpha_ref) - 1) < 1e-9);
 }

@@ -177,6 +177,18 @@ inline int ldlt_negative_eigenvalues(Mat A, const char* package) {
   return neg;
 }
 
+/// || K - K^T ||_F / || K ||_F (collective).
+inline double asymmetry(Mat K) {
+  Mat Kt;
+  HS_PETSC(MatTranspose(K, MAT_INITIAL_MATRIX, &Kt));
+  HS_PETSC(MatAXPY(Kt, -1.0, K, DIFFERENT_NONZERO_PATTERN));
+  PetscReal d, k;
+  HS_PETSC(MatNorm(Kt, NORM_FROBENIUS, &d));
+  HS_PETSC(MatNorm(K, NORM_FROBENIUS, &k));
+  HS_PETSC(MatDestroy(&Kt));
+  return d / k;
+}
+
 inline hs::physics::SpaceOptions degree(int p) {
   hs::physics::SpaceOptions o;
   o.degree = p;

@@ -63,6 +63,18 @@ class Effect {
   /// Adds the nominal external force into the local-vector array `f`. Not collective.
   virtual void add_load(const Space&, PetscScalar* /*f*/) const {}
 
+  // ---- follower loads (configuration-dependent) ------------------------------------------------
+  /// A load that follows the deformation (a pressure on the deformed surface, Nanson's
+  /// n da = J F^-T N dA): its force depends on u and has no potential in general, so its tangent
+  /// is not symmetric. It is a load (has_load(), scaled() as any other), but the Problem assembles
+  /// it at the state through the two functions below, never as a fixed vector (add_load is the
+  /// force at u = 0, for channels and the nominal load's norm).
+  virtual bool follower() const { return false; }
+  /// Adds scale times the force at the state u (local-vector arrays) into `f`. Not collective.
+  virtual void add_follower_load(const Space&, const PetscScalar* /*u*/, double /*scale*/, PetscScalar* /*f*/) const {}
+  /// Adds -scale times its derivative (the load stiffness: the residual is f_int - f) into J.
+  virtual void add_follower_jacobian(const Space&, const PetscScalar* /*u*/, double /*scale*/, Mat /*J*/) const {}
+
   // ---- input channels (what a dataset stores of the effect) ----------------------------------
   /// The model-input field the effect brings ("traction", "body_force"), "" for none. A dataset
   /// stores each channel at the nodes and on the grid; effects of one channel are summed.

@@ -4,6 +4,10 @@
 /// traction; f_fixed: the loads of effects that are not scaled, e.g. gravity under a tuned
 /// traction, assembled only when a scene has one), its tangent, and the potential energy
 /// Pi(u) = int W(F) - (s f_ext + f_fixed) . u.
+/// A follower load (Effect::follower(), e.g. `pressure` with `follower: true`) adds its force at
+/// the state, s f_s(u) + f_f(u), to the load: the tangent then has the non-symmetric load
+/// stiffness -s df_s/du - df_f/du and the problem has no energy (conservative() is false; energy()
+/// still rejects states with det F <= 0 but is no potential).
 #include <array>
 #include <memory>
 #include <vector>
@@ -61,8 +65,15 @@ class Problem {
   DM dm() const { return space_->dm(); }
   MPI_Comm comm() const { return space_->comm(); }
   const std::vector<EffectPtr>& effects() const { return effects_; }
-  /// The nominal external load f_ext, the part the load factor scales (global vector).
-  Vec load() const { return load_.get(); }
+  /// The nominal external load f_ext, the part the load factor scales (global vector), at u = 0
+  /// (a scaled follower load counted with its force at rest).
+  Vec load() const { return nominal_ ? nominal_.get() : load_.get(); }
+  /// -dR/ds at the state u: f_ext + f_s(u); without a scaled follower load, load() itself. The
+  /// vector returned is kept by the problem and overwritten by the next call. Collective.
+  Vec load_at(Vec u) const;
+  /// False where some effect is a follower load: no energy, a non-symmetric tangent (LU, not
+  /// LDL^T), no energy line search, no branch switching.
+  bool conservative() const { return !has_follower_; }
   double load_norm() const { return load_norm_; }
   /// The fixed load f_fixed (global vector), or null when no effect has one.
   Vec fixed_load() const { return fixed_load_.get(); }
@@ -75,8 +86,15 @@ class Problem {
 
   /// Each returns false (on every rank) if u has det F <= 0 at some quadrature point. Collective.
   bool energy(Vec u, double load_factor, double& value) const;
+  /// A merit function on the segment from `from` to `to` for line searches: energy(to) when the
+  /// problem is conservative; with a follower load (no energy), the conservative part's energy at
+  /// `to` minus the follower loads' work along the segment, int_0^1 f(from + t d) . d dt, d = to -
+  /// from (Simpson's rule: exact for the 2D load, linear in u, and the 3D one, quadratic). Its
+  /// derivative along the segment is R . d, as the energy's is. False if `to` is inadmissible.
+  bool energy_along(Vec from, Vec to, double load_factor, double& value) const;
   bool residual(Vec u, double load_factor, Vec r) const;
-  bool jacobian(Vec u, Mat J) const;
+  /// `load_factor` matters only for a scaled follower load (its load stiffness is s df_s/du).
+  bool jacobian(Vec u, Mat J, double load_factor = 0.0) const;
   /// The same residual (load factor 0) and tangent through PETSc's generic pointwise assembly
   /// (PetscDS), for cross-checks and timings. Collective.
   void residual_pointwise(Vec u, Vec r) const;
@@ -93,7 +111,7 @@ class Problem {
   double min_det_f(Vec u) const;
   /// Gathers u on rank 0 in canonical node order (collective).
   NodalField gather(Vec u) const;
-  /// Matrix with the preallocated sparsity of the tangent (symmetric flag set).
+  /// Matrix with the preallocated sparsity of the tangent (symmetric flag set if conservative()).
   core::MatH create_matrix() const;
   core::VecH create_vector() const;
 
@@ -105,7 +123,15 @@ class Problem {
   void assemble_loads(bool scaled, Vec f) const;
   std::vector<EffectPtr> effects_;
   std::unique_ptr<Space> space_;
+  /// Adds -(s f_s(u) + f_f(u)) of the follower loads into the local residual array `r`.
+  void add_follower_loads(const PetscScalar* u, double load_factor, PetscScalar* r) const;
+  /// Adds w_s f_s(u) + w_f f_f(u) (scaled and fixed follower loads at the state u) into the global f.
+  void add_follower_force(Vec u, double scaled_weight, double fixed_weight, Vec f) const;
+  mutable core::VecH along_[3];  ///< energy_along's work vectors
   core::VecH load_, fixed_load_;
+  core::VecH nominal_;          ///< f_ext + f_s(0), only with a scaled follower load
+  mutable core::VecH load_at_;  ///< load_at()'s result
+  bool has_follower_ = false, has_scaled_follower_ = false;
   double load_norm_ = 0;
   mutable core::MatH pattern_;  ///< the tangent's pattern, from the DM once (create_matrix)
 };

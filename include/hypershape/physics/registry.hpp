@@ -26,6 +26,9 @@ EffectPtr make_mooney_rivlin(double C1, double C2, double kappa, ScalarFunction 
 EffectPtr make_linear_elastic(double E, double nu, ScalarFunction field = {});
 /// Dead pressure p on the region's Neumann facets: t = -p N (outward reference normal N).
 EffectPtr make_pressure(double p, const Region& region, int dim);
+/// Follower pressure p on the region's Neumann facets: t = -p J F^-T N, the pressure on the deformed
+/// surface (Nanson). Not conservative in general: its tangent is not symmetric.
+EffectPtr make_follower_pressure(double p, const Region& region, int dim);
 /// Uniform dead traction t (dim components) on the region's Neumann facets.
 EffectPtr make_uniform_traction(const std::vector<double>& t, const Region& region);
 /// Elastic foundation on the region's Neumann facets: energy 1/2 int k_n (u.N)^2 + k_t |u - (u.N)N|^2 dS_0

@@ -14,6 +14,9 @@
 ///  - general (3D, solver groups, or another factorisation asked for in the options): a copy of
 ///    the matrix factored by a preonly Cholesky KSP (configure_direct_solver; the KSP's options
 ///    prefix applies), inertia from MUMPS's INFOG(12) or MatGetInertia.
+///  - LU (symmetric = false: a tangent with a follower load's stiffness): a copy of the matrix
+///    factored by a preonly LU KSP, PETSc's own LU in 2D on one rank, MUMPS otherwise. No inertia
+///    (an LU factor has none): negative_eigenvalues() is -1.
 #include <petscksp.h>
 
 #include <string>
@@ -29,9 +32,10 @@ namespace hypershape::solver {
 /// factorisation (MatGetInertia; 2x2 blocks: from D). -1 where the KSP holds no such factorisation.
 int negative_eigenvalues(KSP ksp);
 
-/// Sets a KSP to LDL^T: PETSc's own (qmd ordering) in 2D on one rank, MUMPS otherwise (options
-/// with the KSP's prefix still apply when the caller calls KSPSetFromOptions).
-void configure_direct_solver(KSP ksp, MPI_Comm comm, int dim);
+/// Sets a KSP to LDL^T (`symmetric`) or LU: PETSc's own (LDL^T: qmd ordering, LU: nested
+/// dissection) in 2D on one rank, MUMPS otherwise (options with the KSP's prefix still apply when
+/// the caller calls KSPSetFromOptions).
+void configure_direct_solver(KSP ksp, MPI_Comm comm, int dim, bool symmetric = true);
 
 /// A GMRES KSP on `comm`, right-preconditioned (its test sees the true residual) by a shell PC
 /// that calls `apply(pc, x, y)` with `ctx`: a kept factor as the preconditioner. Collective.
@@ -40,8 +44,8 @@ core::KSPH make_factor_preconditioned_gmres(MPI_Comm comm, void* ctx, PetscError
 
 class LdltFactor {
  public:
-  /// Collective. `prefix`: options prefix of the factor's KSP.
-  LdltFactor(const physics::Problem& problem, const std::string& prefix);
+  /// Collective. `prefix`: options prefix of the factor's KSP. `symmetric` false: an LU factor.
+  LdltFactor(const physics::Problem& problem, const std::string& prefix, bool symmetric = true);
   LdltFactor(const LdltFactor&) = delete;
   LdltFactor& operator=(const LdltFactor&) = delete;
 
@@ -68,6 +72,7 @@ class LdltFactor {
   void refine();
   static PetscErrorCode apply_factor(PC pc, Vec x, Vec y);
 
+  bool symmetric_ = true;
   bool blocked_ = false;
   bool factored_ = false;
   bool analysed_ = false;

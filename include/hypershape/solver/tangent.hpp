@@ -23,6 +23,16 @@
 ///
 /// Counters (numeric and symbolic factorisations, Krylov iterations, tangent assemblies) are
 /// counted where they happen; log events make -log_view show the split.
+///
+/// A problem with a follower load (physics::Problem::conservative() false) has a non-symmetric
+/// tangent K: it is factorised by LU (PETSc's own in 2D on one rank, MUMPS otherwise), no factor
+/// of K(0) is kept (a fixed follower load drawn per load case changes it), and the multigrid
+/// kind is not available. An LU factor has no inertia; the stability check there is that the
+/// symmetric part (K + K^T)/2 is positive definite, by the inertia of its LDL^T factor (one more
+/// factorisation, counted): a sufficient condition for stability (for every real v, v.K v =
+/// v.(K + K^T)/2 v > 0, so every eigenvalue of K has a positive real part and no divergence
+/// mode exists), not a necessary one. negative_eigenvalues() then counts the negative
+/// eigenvalues of (K + K^T)/2.
 #include <petscksp.h>
 
 #include <cstdint>
@@ -73,8 +83,9 @@ class Tangent {
   Tangent(const Tangent&) = delete;
   Tangent& operator=(const Tangent&) = delete;
 
-  /// K(u) into matrix() (not factorised). False (every rank) if det F <= 0 somewhere. Collective.
-  bool assemble(Vec u);
+  /// K(u) at load factor `s` (which matters only for a scaled follower load) into matrix() (not
+  /// factorised). False (every rank) if det F <= 0 somewhere. Collective.
+  bool assemble(Vec u, double s = 0.0);
   /// Shifts the assembled tangent: K + mu I (inertia-corrected Newton). Collective.
   void shift(double mu);
   /// Factorises the assembled tangent into the work factor, which becomes the one in use.
@@ -90,12 +101,18 @@ class Tangent {
   /// Applies the inverse of the factor in use: y = F^-1 x (no Krylov). Collective.
   bool apply_factor(Vec x, Vec y);
   /// Inertia of the factor in use; -1 unknown. Exact for K(u) only if factor_is_current().
-  int negative_eigenvalues() const;
+  /// Non-symmetric K (LU): the negative eigenvalues of (K + K^T)/2 when the factor in use is of
+  /// the assembled K (its LDL^T made on the first call after the factorisation), else -1. The path
+  /// takes it at its final state only (stability()): one LDL^T per target solve.
+  int negative_eigenvalues();
+  /// The tangent is factorised by LU (a follower load), not by LDL^T.
+  bool lu() const { return !problem_.conservative(); }
   /// Multigrid kind: whether the assembled tangent is positive definite, for the stability
   /// check of a converged state without its factorisation: LOBPCG preconditioned by the AMG
   /// from `start` (overwritten), and, where that does not settle the sign, a factorisation.
   /// Returns 0 (positive definite), >= 1 (indefinite; exact count only if factorised) or -1
-  /// (the factorisation failed). Collective.
+  /// (the factorisation failed). LU kind: the negative eigenvalues of (K + K^T)/2 of the assembled
+  /// K (its LDL^T; `start` unused). Collective.
   int stability(Vec start);
   /// The tangent is solved by AMG-preconditioned Krylov (not by a factorisation).
   bool multigrid() const { return linear_ == LinearSolver::gamg || linear_ == LinearSolver::hypre; }
@@ -112,6 +129,8 @@ class Tangent {
 
  private:
   LdltFactor& factor() const { return use_rest_ ? *rest_ : *work_; }
+  /// LU kind: the negative eigenvalues of (K + K^T)/2 of the assembled K (LDL^T of S_).
+  int symmetric_part_inertia();
   bool krylov_solve(Vec b, Vec x, bool guess, int max_its, bool& converged);
   /// Multigrid kind: the AMG of the assembled tangent, set up once per assembly.
   void set_up_multigrid();
@@ -129,6 +148,10 @@ class Tangent {
   core::MatH J_;        ///< the assembled tangent K(u) (the Krylov operator)
   core::MatH J0_;       ///< K(0), 2D
   std::unique_ptr<LdltFactor> work_, rest_;  ///< of the current tangent at factorise(); of K(0)
+  // LU kind: (K + K^T)/2, K^T, the LDL^T of the former and its count (-2: not yet for this K).
+  core::MatH S_, Kt_;
+  std::unique_ptr<LdltFactor> symmetric_part_;
+  int symmetric_negative_ = -2;
   core::KSPH krylov_;   ///< GMRES on J_, right-preconditioned by the factor in use (PC shell)
   LinearSolver linear_ = LinearSolver::direct;  ///< resolved (never automatic)
   core::KSPH amg_;      ///< multigrid kind: CG + AMG on J_

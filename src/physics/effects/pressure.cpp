@@ -1,5 +1,6 @@
 /// Effect "pressure": a dead pressure p on a boundary region, t = -p N with N the outward unit
-/// normal of the reference configuration (p > 0 pushes into the body). Scaled by alpha (the
+/// normal of the reference configuration (p > 0 pushes into the body); with `follower: true` the
+/// pressure acts on the deformed surface (follower_pressure.cpp). Scaled by alpha (the
 /// default) or fixed (scale: fixed). Keys: value (p), the region (region.hpp). Input channel
 /// "pressure" (one component): p in the region (at the Neumann nodes; on the grid, at the points
 /// of the region), 0 elsewhere.
@@ -22,10 +23,15 @@ void register_pressure() {
   register_effect(
       "pressure",
       [](const core::Params& p, int dim) {
-        return make_pressure(p.number("value"), Region::from_params(p, dim, false), dim);
+        const double value = p.number("value");
+        const Region region = Region::from_params(p, dim, false);
+        const std::string follower = p.has("follower") ? p.text("follower") : "false";
+        if (follower != "true" && follower != "false") p.fail("follower", "must be true or false");
+        return follower == "true" ? make_follower_pressure(value, region, dim) : make_pressure(value, region, dim);
       },
-      std::string("dead pressure t = -p N (N: outward normal of the reference configuration); keys: value (p), ") +
-          region_help() + "; scale: alpha (default) | fixed");
+      std::string("pressure, dead t = -p N (N: outward normal of the reference configuration) or, with follower: "
+                  "true, on the deformed surface t = -p J F^-T N (no energy: LU solves); keys: value (p), ") +
+          region_help() + "; follower: false (default) | true; scale: alpha (default) | fixed");
 }
 
 }  // namespace hypershape::physics

@@ -13,6 +13,7 @@
 
 #include "hypershape/core/error.hpp"
 #include "hypershape/physics/registry.hpp"
+#include "facet_cells.hpp"
 
 namespace hypershape::physics {
 
@@ -32,11 +33,7 @@ class Spring : public Effect {
 
  private:
   /// A selected facet: its view, the support cell and each facet node's index in the cell.
-  struct Face {
-    const FacetView* view;
-    PetscInt cell;
-    std::array<int, 6> cell_node;
-  };
+  using Face = detail::FacetCell;
   /// The 3x3 (dim used) spring tensor k_n N N^T + k_t (I - N N^T) of a facet.
   std::array<double, 9> tensor(const FacetView& f, int dim) const;
   /// M_ab = int N_a N_b dS_0 over the facet (the facet rule), n_nodes x n_nodes row-major.
@@ -83,26 +80,7 @@ std::array<double, 36> Spring::facet_mass(const Space& s, const FacetView& f) co
   return m;
 }
 
-void Spring::setup(const Space& s) {
-  const int dim = s.dim();
-  faces_.clear();
-  for (const FacetView& f : s.neumann_facets()) {
-    double x[9];
-    for (int a = 0; a < f.n_vertices; ++a)
-      for (int k = 0; k < dim; ++k) x[a * dim + k] = f.x[std::size_t(a)][std::size_t(k)];
-    if (select_ && !select_(x, f.n_vertices, dim)) continue;
-    const PetscInt* support;
-    HS_PETSC(DMPlexGetSupport(s.dm(), f.point, &support));
-    Face face{&f, support[0], {}};
-    const PetscInt* ld = s.local_dofs(face.cell);
-    for (int n = 0; n < f.n_nodes; ++n) {
-      const auto it = std::find(ld, ld + s.n_cell_dofs(), f.offset[std::size_t(n)]);
-      if (it == ld + s.n_cell_dofs()) throw std::logic_error("spring: a facet node is not in its cell");
-      face.cell_node[std::size_t(n)] = int(it - ld) / dim;
-    }
-    faces_.push_back(face);
-  }
-}
+void Spring::setup(const Space& s) { faces_ = detail::facet_cells(s, select_); }
 
 bool Spring::add_energy(const Space& s, const PetscScalar* u, double& energy) const {
   for_each_entry(s, [&](const Face& face, int a, int i, int b, int j, double c) {
