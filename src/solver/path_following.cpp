@@ -50,13 +50,40 @@ std::string unstable_reason(double target, double alpha, int negative, double sl
 
 }  // namespace
 
+const std::vector<PetscInt>& NonlinearSolver::global_of_local() {
+  if (!global_of_local_.empty()) return global_of_local_;
+  DM dm = problem_.dm();
+  core::VecH g = problem_.create_vector();
+  PetscInt lo, hi;
+  HS_PETSC(VecGetOwnershipRange(g, &lo, &hi));
+  {
+    core::VecArray<PetscScalar> gv(g);
+    for (PetscInt i = lo; i < hi; ++i) gv[i - lo] = PetscScalar(i);
+  }
+  Vec l;
+  HS_PETSC(DMGetLocalVector(dm, &l));
+  HS_PETSC(VecSet(l, -1.0));  // constrained entries: the global vector has none
+  HS_PETSC(DMGlobalToLocal(dm, g, INSERT_VALUES, l));
+  PetscInt n;
+  HS_PETSC(VecGetLocalSize(l, &n));
+  global_of_local_.assign(std::size_t(n), -1);
+  {
+    core::VecArray<const PetscScalar> lv(l);
+    for (PetscInt i = 0; i < n; ++i) {
+      const auto k = PetscInt(std::llround(PetscRealPart(lv[i])));
+      global_of_local_[std::size_t(i)] = k >= lo && k < hi ? k : -1;  // owned entries only
+    }
+  }
+  HS_PETSC(DMRestoreLocalVector(dm, &l));
+  return global_of_local_;
+}
+
 double NonlinearSolver::control_direction(Vec u, Vec fallback, Vec c) {
   DM dm = problem_.dm();
   const int dim = problem_.space().dim();
   const MPI_Comm comm = problem_.comm();
-  Vec ul, cl;
+  Vec ul;
   HS_PETSC(DMGetLocalVector(dm, &ul));
-  HS_PETSC(DMGetLocalVector(dm, &cl));
   std::int64_t node = -1;
   // The node of the largest |v| (ties: the smallest canonical index, on any rank count).
   auto largest = [&](Vec v, PetscInt& offset, double& norm2) {
@@ -84,14 +111,15 @@ double NonlinearSolver::control_direction(Vec u, Vec fallback, Vec c) {
   largest(u, off, m2);
   if (m2 <= 0.0) largest(fallback, off, m2);  // u = 0: the node that will move most
   const double m = std::sqrt(std::max(m2, 0.0));
-  HS_PETSC(VecSet(cl, 0.0));
-  if (off >= 0 && m > 0) {  // ul still holds the vector the node was picked from
+  const std::vector<PetscInt>& global = global_of_local();  // collective at its first call
+  HS_PETSC(VecSet(c, 0.0));
+  if (off >= 0 && m > 0) {  // ul still holds the vector the node was picked from (owned here)
     core::VecArray<const PetscScalar> a(ul);
-    core::VecArray<PetscScalar> cv(cl);
-    for (int i = 0; i < dim; ++i) cv[off + i] = a[off + i] / m;
+    for (int i = 0; i < dim; ++i)
+      if (global[std::size_t(off + i)] >= 0) HS_PETSC(VecSetValue(c, global[std::size_t(off + i)], a[off + i] / m, INSERT_VALUES));
   }
-  HS_PETSC(DMLocalToGlobal(dm, cl, INSERT_VALUES, c));  // owned entries only
-  HS_PETSC(DMRestoreLocalVector(dm, &cl));
+  HS_PETSC(VecAssemblyBegin(c));
+  HS_PETSC(VecAssemblyEnd(c));
   HS_PETSC(DMRestoreLocalVector(dm, &ul));
   PetscReal cu;
   HS_PETSC(VecDot(c, u, &cu));
