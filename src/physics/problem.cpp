@@ -93,6 +93,11 @@ void Problem::assemble_load() {
   assemble_loads(false, fixed_load_);
 }
 
+bool Problem::has_fixed_load() const {
+  return std::any_of(effects_.begin(), effects_.end(),
+                     [](const EffectPtr& e) { return e->has_load() && !e->scaled() && e->active(); });
+}
+
 void Problem::reassemble_load() {
   for (auto& e : effects_)
     if (e->has_load()) e->setup(*space_);

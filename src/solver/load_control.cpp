@@ -14,10 +14,10 @@
 
 namespace hypershape::solver {
 
-bool NonlinearSolver::newton(double s, SolveResult& r) {
+bool NonlinearSolver::newton(double s, SolveResult& r, double fixed_norm, double rtol) {
   s_eval_ = s;
   if (!user_atol_) {
-    const double atol = opt_.atol + opt_.rtol * std::abs(s) * problem_.load_norm();
+    const double atol = opt_.atol + (rtol > 0 ? rtol : opt_.rtol) * (std::abs(s) * problem_.load_norm() + fixed_norm);
     HS_PETSC(SNESSetTolerances(snes_, atol, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));
   }
   HS_PETSC(SNESSolve(snes_, nullptr, u_));

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -16,10 +17,8 @@
 
 namespace hypershape::solver {
 
-namespace {
-
 /// The load's extremes along a path and where they were (a fold's limit points).
-struct LoadExtremes {
+struct NonlinearSolver::LoadExtremes {
   double max_alpha = -INFINITY, d_at_max = 0, min_alpha = INFINITY, d_at_min = 0;
   void add(double alpha, double d) {
     if (alpha > max_alpha) max_alpha = alpha, d_at_max = d;
@@ -27,12 +26,15 @@ struct LoadExtremes {
   }
 };
 
+namespace {
+
 /// The reason of an equilibrium on target whose own tangent has `negative` negative eigenvalues,
 /// with slope = d max|u| / d alpha there (c . K^-1 f_ext). A fold where one eigenvalue is
 /// negative and max|u| falls as the load rises: the path (one state per max|u|, continuous)
 /// passed a limit point of the load between its start and the target, and its one state with
 /// max|u| = target is unstable: no stable equilibrium on target is on this path.
-std::string unstable_reason(double target, double alpha, int negative, double slope, const LoadExtremes& e,
+std::string unstable_reason(double target, double alpha, int negative, double slope,
+                            const NonlinearSolver::LoadExtremes& e,
                             bool conservative) {
   auto num = [](double x) { return std::to_string(x); };
   if (!conservative)
@@ -46,6 +48,28 @@ std::string unstable_reason(double target, double alpha, int negative, double sl
            num(e.d_at_max) + ", min " + num(e.min_alpha) + " at max|u| = " + num(e.d_at_min) + ")";
   return "loss of stability at max|u| = " + num(target) + ", alpha = " + num(alpha) + ": the tangent has " +
          std::to_string(negative) + " negative eigenvalue(s) (buckling or a bifurcation)";
+}
+
+/// Step control by the corrector's count `n`: double after <= 2 iterations, halve after >= 6.
+/// Measured on Random2D (8 x 25, P1): the increment after a doubling failed in 13%, 11% and 18%
+/// of cases after 1, 2 and 3 iterations (a failure costs 5.7 iterations, an accepted
+/// intermediate increment 3.1); doubling after <= 3 and halving after >= 8 (before): 13.3 Newton
+/// iterations per load case, this rule 12.6 (0.24 failed increments per load case against
+/// 0.34), all 200 converged.
+double next_step(double step, int n) {
+  if (n <= 2) return 2.0 * step;
+  return n >= 6 ? 0.5 * step : step;
+}
+
+/// Why the path gives up after a failed increment (none: it goes on with the halved `step`).
+std::optional<std::string> give_up_reason(int failed_in_a_row, int its, double step, double min_step, int solves,
+                           const SolverOptions& opt, const std::string& why) {
+  if (failed_in_a_row == opt.max_halvings)
+    return std::to_string(failed_in_a_row) + " failed increments in a row (last: " + why + ")";
+  if (its >= opt.newton_budget) return why;
+  if (std::abs(step) < min_step || solves >= opt.max_increments)
+    return "increment below minimum or too many increments (last: " + why + ")";
+  return std::nullopt;
 }
 
 }  // namespace
@@ -253,7 +277,9 @@ void NonlinearSolver::finish_path(TargetResult& t, bool at_target) {
   t.max_displacement = problem_.max_displacement(u_);
   t.alpha = s_;
   t.negative_pivots = negative_pivots_;
-  t.converged = at_target && !(negative_pivots_ > 0);
+  t.converged = at_target && !(negative_pivots_ > 0) && s_ >= 0;
+  if (at_target && s_ < 0)
+    t.reason = "max|u| = target reached only with the scaled load reversed (alpha = " + std::to_string(s_) + " < 0)";
   if (t.converged) {
     // Leave the SNES as a load-controlled solve would (set up, callbacks at this load); at a
     // converged state this is one residual evaluation and zero Newton iterations.
@@ -264,33 +290,141 @@ void NonlinearSolver::finish_path(TargetResult& t, bool at_target) {
   }
 }
 
+bool NonlinearSolver::unstable_on_target(double d, const LoadExtremes& extremes, TargetResult& t) {
+  // An equilibrium whose tangent is indefinite: not a minimum of the energy, so not a state the
+  // loaded body rests in (it buckles away from it). Only the final state is checked: the
+  // elastic equilibria are path-independent, and intermediate states are converged to path_rtol
+  // only, where the inertia of a state far from equilibrium would reject good paths (measured:
+  // 25 against 13 such failures in 1000 Random2D load cases). Judged and classified on this
+  // state's own tangent (the corrector's last factor is one Newton step older): its inertia and
+  // d max|u| / d alpha = c . K^-1 f_ext. A follower load keeps the check of its tangent's
+  // symmetric part (no energy, no fold to classify).
+  if (negative_pivots_ <= 0) return false;  // the corrector's last factor was positive definite
+  const int older = negative_pivots_;
+  PetscReal slope = 0;
+  if (problem_.conservative() && factorise_here() && tangent_->apply_factor(problem_.load(), w_)) {
+    control_direction(u_, w_, c_);
+    HS_PETSC(VecDot(c_, w_, &slope));
+  }
+  if (negative_pivots_ < 0) negative_pivots_ = older;
+  if (negative_pivots_ <= 0) return false;
+  t.reason = unstable_reason(d, s_, negative_pivots_, slope, extremes, problem_.conservative());
+  return true;
+}
+
+/// The first step of a path from max|u| = d to `target`. At a load case's start (`fresh`: from
+/// rest or from the fixed loads' state), the first increment the previous load case of this
+/// problem took (its load differs, its difficulty is alike): measured on Random2D draws, this
+/// halves the discarded increments against a first try at the whole target
+/// (scripts/bench_generate.sh).
+double NonlinearSolver::first_step(double target, double d, bool fresh) const {
+  const double step = target - d;
+  return fresh && step > 0 && step_hint_ > 0 ? std::min(step, step_hint_) : step;
+}
+
+bool NonlinearSolver::start_under_fixed_loads(double target, int& its) {
+  // Measured on multi_load2d (gravity fixed under three tractions; 20 shapes x 50 load cases):
+  // from u = 0 the first corrector met gravity and the traction at once; where gravity alone
+  // moves another node than the traction (a hanging tip) by more than the increment, no state
+  // near rest has that max|u|, and the corrector made no progress down to increments of 1/32 of
+  // the target (14 of 15 failures there).
+  if (!problem_.residual(u_, 0.0, r_)) return false;
+  PetscReal f0;
+  HS_PETSC(VecNorm(r_, NORM_2, &f0));
+  // Converged as an intermediate state of the path is (path_rtol; the final one is to rtol).
+  SolveResult r;
+  const bool ok = newton(0.0, r, f0, opt_.path_rtol);
+  its += r.newton_iterations;
+  HS_PETSC(PetscInfo(snes_.get(), "fixed loads alone (|R(0)| %g): %s in %d Newton its, max|u| %g\n", double(f0),
+                     ok ? "converged" : r.reason.c_str(), r.newton_iterations, problem_.max_displacement(u_)));
+  if (!ok) {
+    HS_PETSC(VecZeroEntries(u_));
+    return false;
+  }
+  // The node the fixed loads move most need not be the scaled load's: where the scaled load first
+  // lowers max|u| (it lifts the hanging node), displacement control from here takes alpha
+  // negative (measured: 492 of those 1000 load cases reached their target with the load
+  // reversed); where it barely moves that node, the corrector overshoots alpha and the control
+  // node switches (7 of their 1000 failed so). Load steps first, doubling, until max|u| grows
+  // with alpha at a quarter of the rate of the node the scaled load moves most.
+  for (int k = 0; k < 12; ++k) {
+    if (!tangent_response(false)) return false;
+    const double m = control_direction(u_, a_, c_);
+    const double response = problem_.max_displacement(a_);
+    PetscReal slope;
+    HS_PETSC(VecDot(c_, a_, &slope));
+    HS_PETSC(PetscInfo(snes_.get(), "under fixed loads at alpha %g: max|u| %g, d max|u| / d alpha %g (largest %g)\n", s_,
+                       m, double(slope), response));
+    if (slope > 0.25 * response || m >= target) return true;
+    // The first step: where the scaled load alone would move its node as far as the fixed ones;
+    // then doubling alpha.
+    if (!load_step(s_ > 0 ? s_ : m / response, f0, its)) return true;  // a_ is this state's
+  }
+  return false;
+}
+
+bool NonlinearSolver::load_step(double step, double fixed_norm, int& its) {
+  HS_PETSC(VecCopy(u_, backup_));
+  for (int halving = 0; halving < 4; ++halving, step *= 0.5) {
+    SolveResult r;
+    const bool ok = newton(s_ + step, r, fixed_norm, opt_.path_rtol);
+    its += r.newton_iterations;
+    if (ok) {
+      s_ += step;
+      return true;
+    }
+    HS_PETSC(VecCopy(backup_, u_));
+  }
+  return false;
+}
+
 TargetResult NonlinearSolver::follow_path(double target, double start, int spent) {
-  TargetResult t;
   if (!(target > 0) || !std::isfinite(target)) {
+    TargetResult t;
     t.reason = "target max|u| must be positive";
     return t;
   }
+  const bool fresh = s_ == 0 && problem_.max_displacement(u_) == 0;  // a load case's start
+  if (!fresh || !problem_.has_fixed_load()) return path(target, start, spent, PathStart::here);
+  // With fixed loads, from rest first: it is the cheaper start where it works (from the fixed
+  // loads' state, measured on the catalogue's fixed pressures: 5.4 -> 7.9 Newton iterations per
+  // load case, organ_pressure3d 12.8 -> 16.0, the same equilibria). Where its first increment
+  // fails, or it reaches the target only at alpha < 0, again from the fixed loads' state.
+  TargetResult rest = path(target, start, spent, PathStart::rest_once);
+  if (rest.converged || (rest.increments > 0 && s_ >= 0)) return rest;
+  HS_PETSC(PetscInfo(snes_.get(), "from rest: %s; again from the fixed loads' equilibrium\n", rest.reason.c_str()));
+  HS_PETSC(VecZeroEntries(u_));
+  s_ = 0;
+  TargetResult t = path(target, start, spent + rest.newton_iterations, PathStart::fixed_loads);
+  t.solves += rest.solves;
+  t.newton_iterations += rest.newton_iterations;
+  t.failed_increments += rest.failed_increments + rest.increments;
+  t.recovery_iterations += rest.newton_iterations;
+  t.seconds_first_solve = rest.seconds_first_solve;
+  return t;
+}
+
+TargetResult NonlinearSolver::path(double target, double start, int spent, PathStart how) {
+  TargetResult t;
+  int its = spent;  // the Newton budget counts what the target solve spent before
   double d = problem_.max_displacement(u_);
+  const bool fresh = d == 0 && s_ == 0;  // a load case's start (not a branch switch's)
+  const bool ready = how == PathStart::fixed_loads && start_under_fixed_loads(target, its);
+  const double d_start = d = problem_.max_displacement(u_);
   // From rest in 2D, K(0) is factorised once per problem. Not in 3D: a second MUMPS factor
   // there doubles the factor memory (hundreds of MiB per rank at the 3D presets' sizes) for
   // one factorisation in about ten per load case.
-  const bool cached_rest = d == 0 && problem_.space().dim() == 2;
-  if (!(cached_rest ? rest_response() : tangent_response(false))) {
+  const bool from_rest = d == 0;
+  if (!ready && !(from_rest && problem_.space().dim() == 2 ? rest_response() : tangent_response(false))) {
     t.reason = "tangent factorisation or solve failed at the start";
     return t;
   }
-  double step = target - d;
-  // From rest, the first increment is the one the previous load case of this problem took
-  // first (its load differs, its difficulty is alike): measured on Random2D draws, this halves
-  // the discarded increments against a first try at the whole target (scripts/bench_generate.sh).
-  const bool from_rest = d == 0;
-  if (from_rest && step_hint_ > 0) step = std::min(step, step_hint_);
+  double step = first_step(target, d, fresh);
   bool first_accepted = true;
   int failed_in_a_row = 0;
   // Increments below 1e-3 of the way (or min_increment, if larger) are a stalled path: it
   // creeps along a limit point (measured: the budget spent on increments of 1e-4 of the way).
   const double min_step = std::abs(target - d) * std::max(opt_.min_increment, 1e-3);
-  int its = spent;  // the Newton budget counts what the target solve spent before
   std::string why;
   LoadExtremes extremes;
   extremes.add(s_, d);
@@ -306,45 +440,19 @@ TargetResult NonlinearSolver::follow_path(double target, double start, int spent
     if (t.solves == 1) t.seconds_first_solve = core::now_seconds() - start;
     HS_PETSC(PetscInfo(snes_.get(), "path to %g: %g -> %g%s: %s in %d Newton its (alpha %g)\n", target, d, d_next,
                        last ? " (last)" : "", ok ? "converged" : why.c_str(), its - its_before, s_));
-    if (ok && last && negative_pivots_ > 0) {
-      // An equilibrium whose tangent is indefinite: not a minimum of the energy, so not a state
-      // the loaded body rests in (it buckles away from it). Only the final state is checked:
-      // the elastic equilibria are path-independent, and intermediate states are converged
-      // to path_rtol only, where the inertia of a state far from equilibrium would reject
-      // good paths (measured: 25 against 13 such failures in 1000 Random2D load cases).
-      // Judged and classified on this state's own tangent (the corrector's last factor is one
-      // Newton step older): its inertia and d max|u| / d alpha = c . K^-1 f_ext. A follower load
-      // keeps the check of its tangent's symmetric part (no energy, no fold to classify).
-      const int older = negative_pivots_;
-      PetscReal slope = 0;
-      if (problem_.conservative() && factorise_here() && tangent_->apply_factor(problem_.load(), w_)) {
-        control_direction(u_, w_, c_);
-        HS_PETSC(VecDot(c_, w_, &slope));
-      }
-      if (negative_pivots_ < 0) negative_pivots_ = older;
-      if (negative_pivots_ > 0) {
-        t.reason = unstable_reason(d_next, s_, negative_pivots_, slope, extremes, problem_.conservative());
-        ++t.increments;
+    if (ok) {
+      ++t.increments;
+      if (last && unstable_on_target(d_next, extremes, t)) {
         d = d_next;
         break;
       }
-    }
-    if (ok) {
-      ++t.increments;
       extremes.add(s_, d_next);
       failed_in_a_row = 0;
-      if (first_accepted && from_rest) step_hint_ = d_next;
+      if (first_accepted && fresh) step_hint_ = d_next - d_start;
       first_accepted = false;
       d = d_next;
       if (last) break;
-      // Step control by the corrector's count: double after <= 2 iterations, halve after >= 6.
-      // Measured on Random2D (8 x 25, P1): the increment after a doubling failed in 13%, 11%
-      // and 18% of cases after 1, 2 and 3 iterations (a failure costs 5.7 iterations, an
-      // accepted intermediate increment 3.1); doubling after <= 3 and halving after >= 8
-      // (before): 13.3 Newton iterations per load case, this rule 12.6 (0.24 failed increments
-      // per load case against 0.34), all 200 converged.
-      const int n = its - its_before;
-      if (n <= 2) step *= 2.0; else if (n >= 6) step *= 0.5;
+      step = next_step(step, its - its_before);
       continue;
     }
     ++t.failed_increments;
@@ -353,16 +461,12 @@ TargetResult NonlinearSolver::follow_path(double target, double start, int spent
     HS_PETSC(VecCopy(a0_, a_));
     s_ = s_backup;
     step = 0.5 * (d_next - d);  // half the increment that failed (step may have been longer)
-    if (++failed_in_a_row == opt_.max_halvings) {
-      t.reason = std::to_string(failed_in_a_row) + " failed increments in a row (last: " + why + ")";
+    if (how == PathStart::rest_once && first_accepted) {
+      t.reason = "first increment from rest failed (" + why + ")";
       break;
     }
-    if (its >= opt_.newton_budget) {
-      t.reason = why;
-      break;
-    }
-    if (std::abs(step) < min_step || t.solves >= opt_.max_increments) {
-      t.reason = "increment below minimum or too many increments (last: " + why + ")";
+    if (auto reason = give_up_reason(++failed_in_a_row, its, step, min_step, t.solves, opt_, why)) {
+      t.reason = *reason;
       break;
     }
   }

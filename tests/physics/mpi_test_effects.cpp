@@ -5,6 +5,7 @@
 #include <functional>
 
 #include "hypershape/physics/material_params.hpp"
+#include "hypershape/physics/registry.hpp"
 #include "hypershape/solver/nonlinear.hpp"
 #include "support/helpers.hpp"
 
@@ -20,10 +21,10 @@ double broadcast(double v) {
 }
 
 /// The clamped disk with the given material and loads, solved at load factor `alpha`.
-std::vector<double> solve(MPI_Comm comm, const Effects& effects, double alpha, bool& converged) {
+std::vector<double> solve(MPI_Comm comm, const Effects& effects, double alpha, bool& converged, int degree = 1) {
   mesh::MeshData m;
-  if (core::rank(comm) == 0) m = hstest::disk_mesh(0.1);
-  physics::Problem p(comm, m, effects(), hstest::degree(1));
+  if (core::rank(comm) == 0) m = hstest::disk_mesh(degree == 1 ? 0.1 : 0.2);
+  physics::Problem p(comm, m, effects(), hstest::degree(degree));
   solver::NonlinearSolver ns(p);
   converged = ns.solve(alpha).converged;
   return p.gather(ns.solution()).values;
@@ -43,7 +44,12 @@ physics::EffectPtr traction() { return physics::make_gaussian_traction({-1.0, 0.
 
 TEST_CASE("Catalogue effects have the same solution on any number of ranks", "[mpi][effects]") {
   const physics::ScalarFunction field = [f = physics::LogNormalField(2, 0.4, 0.3, 5)](const double* x) { return f(x); };
-  const std::pair<const char*, Effects> cases[] = {
+  struct Case {
+    const char* name;
+    Effects effects;
+    int degree = 1;
+  };
+  const Case cases[] = {
       {"saint_venant_kirchhoff", [] { return scene(physics::make_saint_venant_kirchhoff(500, 0.4), traction()); }},
       {"mooney_rivlin", [] { return scene(physics::make_mooney_rivlin(60, 20, 800), traction()); }},
       {"linear_elastic", [] { return scene(physics::make_linear_elastic(500, 0.4), traction()); }},
@@ -76,13 +82,15 @@ TEST_CASE("Catalogue effects have the same solution on any number of ranks", "[m
        [inc = physics::InclusionField(2, 4, 0.3, 5.0, 3)] {
          return scene(physics::make_neo_hookean(500, 0.4, [inc](const double* x) { return inc(x); }), traction());
        }},
+      {"neo_hookean with dilatation: mean, nu 0.499, P2, with a modulus field",
+       [field] { return scene(physics::make_neo_hookean_mean_dilatation(500, 0.499, field), traction()); }, 2},
   };
-  for (const auto& [name, effects] : cases) {
+  for (const auto& [name, effects, degree] : cases) {
     DYNAMIC_SECTION(name) {
       bool ref_ok = false, ok = false;
       std::vector<double> ref;
-      if (core::rank(PETSC_COMM_WORLD) == 0) ref = solve(PETSC_COMM_SELF, effects, 10.0, ref_ok);
-      const std::vector<double> u = solve(PETSC_COMM_WORLD, effects, 10.0, ok);
+      if (core::rank(PETSC_COMM_WORLD) == 0) ref = solve(PETSC_COMM_SELF, effects, 10.0, ref_ok, degree);
+      const std::vector<double> u = solve(PETSC_COMM_WORLD, effects, 10.0, ok, degree);
       double d = 0, scale = 0;
       for (std::size_t i = 0; i < ref.size() && i < u.size(); ++i)
         d = std::max(d, std::abs(u[i] - ref[i])), scale = std::max(scale, std::abs(ref[i]));

@@ -12,6 +12,7 @@
 #include "hypershape/core/error.hpp"
 #include "hypershape/physics/linear_elastic.hpp"
 #include "hypershape/physics/mooney_rivlin.hpp"
+#include "hypershape/physics/registry.hpp"
 #include "hypershape/physics/saint_venant_kirchhoff.hpp"
 #include "support/helpers.hpp"
 #include "support/kernel_checks.hpp"
@@ -347,6 +348,7 @@ TEST_CASE("Catalogue materials reject bad parameters naming the key", "[material
       {"neo_hookean", core::MapParams({{"E", 1.0}, {"nu", 0.3}, {"E_cv", 0.5}}), "E_length"},
       {"neo_hookean", core::MapParams({{"E", 1.0}, {"nu", 0.3}, {"E_cv", -0.5}, {"E_length", 0.1}}), "E_cv"},
       {"linear_elastic", core::MapParams({{"E", 1.0}, {"nu", 0.3}, {"E_length", 0.1}}), "E_length"},
+      {"neo_hookean", core::MapParams({{"E", 1.0}, {"nu", 0.3}, {"dilatation", std::string("average")}}), "dilatation"},
   };
   for (const Bad& b : cases) {
     INFO(b.effect << ": expecting a message naming " << b.key);
@@ -357,4 +359,56 @@ TEST_CASE("Catalogue materials reject bad parameters naming the key", "[material
       CHECK_THAT(e.what(), Catch::Contains(b.key));
     }
   }
+}
+
+// ---- the mean-dilatation Neo-Hookean (dilatation: mean) ----------------------------------------
+
+TEST_CASE("Mean dilatation: energy, residual and tangent consistent; the pointwise material where J is constant per cell",
+          "[assembly][materials][mean_dilatation]") {
+  auto residual = [](const Problem& p, Vec u) {
+    core::VecH r = p.create_vector();
+    REQUIRE(p.residual(u, 0.0, r));
+    return r;
+  };
+  for (const double nu : {0.45, 0.499})
+    for (int degree : {1, 2}) {
+      DYNAMIC_SECTION("nu " << nu << " P" << degree) {
+        auto mean = disk_problem(make_neo_hookean_mean_dilatation(E, nu), degree);
+        auto pointwise = disk_problem(make_neo_hookean(E, nu), degree);
+        // Unconstrained twins for the homogeneous deformation (a patch would pin its nodes).
+        auto free_body = [&](EffectPtr material) {
+          std::vector<EffectPtr> effects;
+          effects.push_back(std::move(material));
+          return std::make_unique<Problem>(PETSC_COMM_WORLD, hstest::disk_mesh(0.2), std::move(effects),
+                                           hstest::degree(degree));
+        };
+        auto mean_free = free_body(make_neo_hookean_mean_dilatation(E, nu));
+        auto pointwise_free = free_body(make_neo_hookean(E, nu));
+        core::VecH u = mean->create_vector(), v = mean->create_vector(), affine = mean_free->create_vector();
+        hstest::interpolate(*mean, [](const double* x, double* f) { smooth_field(x, f, 0.5); }, u);
+        hstest::interpolate(*mean, [](const double* x, double* f) {
+          f[0] = 0.1 * x[1] * x[1] + 0.05;
+          f[1] = -0.2 * x[0] * x[1];
+        }, v);
+        REQUIRE(mean->min_det_f(u) < 0.99);
+        check_consistency(*mean, u, v);
+        // A homogeneous deformation (J the same everywhere) and, on P1, any field (J constant per
+        // cell): theta_e = J, the pointwise Neo-Hookean's residual and energy.
+        hstest::interpolate(*mean_free, [](const double* x, double* f) {
+          f[0] = 0.08 * x[0] - 0.05 * x[1];
+          f[1] = 0.03 * x[0] - 0.06 * x[1];
+        }, affine);
+        auto same = [&](const Problem& a, const Problem& b, Vec w) {
+          CHECK(hstest::rel_diff(residual(a, w), residual(b, w)) < 1e-12);
+          double ea = 0, eb = 0;
+          REQUIRE(a.energy(w, 0.0, ea));
+          REQUIRE(b.energy(w, 0.0, eb));
+          CHECK(ea == Approx(eb).epsilon(1e-12));
+        };
+        same(*mean_free, *pointwise_free, affine);
+        if (degree == 1) same(*mean, *pointwise, u);
+        // On P2 a non-affine field's J varies within cells: the energies differ.
+        if (degree == 2) CHECK(hstest::rel_diff(residual(*mean, u), residual(*pointwise, u)) > 1e-4);
+      }
+    }
 }

@@ -11,6 +11,7 @@
 #include <iostream>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "hypershape/config/dataset.hpp"
@@ -29,16 +30,16 @@ int env_int(const char* name, int fallback) {
   return v ? std::atoi(v) : fallback;
 }
 
-/// The Random2D preset's shape `shape_id` of `seed`, its 50 load cases and problem, as the factory
-/// builds them.
+/// Shape `shape_id` of `seed` of a dataset config (default: the Random2D preset), its 50 load
+/// cases and problem, as the factory builds them.
 struct Case {
   config::DatasetConfig cfg;
   factory::ShapeSample shape;
   std::vector<factory::LoadCase> loads;
   factory::ShapeProblem sp;
 
-  Case(std::uint64_t seed, int shape_id)
-      : cfg(config::parse_dataset_file(std::string(HS_SOURCE_DIR) + "/configs/presets/random2d.yaml")) {
+  Case(std::uint64_t seed, int shape_id, const std::string& config = HS_SOURCE_DIR "/configs/presets/random2d.yaml")
+      : cfg(config::parse_dataset_file(config)) {
     cfg.loads.count = 50;  // the targets are stratified over the load count: keep the preset's
     cfg.seed = seed;
     shape = factory::make_shape(factory::shape_config(cfg, shape_id), std::nullopt, cfg.seed, shape_id);
@@ -87,10 +88,14 @@ TEST_CASE("Unseen-seed load cases that need a branch switch end stable on target
 }
 
 /// Replays a shape's load cases FROM..LOAD as the factory does (one solver, in order: the first
-/// increment of each is the previous one's), printing the failures and the last:
+/// increment of each is the previous one's), printing the failures and the last; CONFIG: another
+/// dataset config (with 50 load cases per shape, as scripts/bench_stability.sh runs it):
 ///   SEED=777 SHAPE=3 LOAD=47 PETSC_OPTIONS="-info :snes" unit_tests "[unseen_replay]"
+///   CONFIG=configs/examples/multi_load2d.yaml SEED=17 SHAPE=19 LOAD=3 unit_tests "[unseen_replay]"
 TEST_CASE("Replay one shape's load cases as the factory does", "[.][unseen_replay]") {
-  Case c(std::uint64_t(env_int("SEED", 777)), env_int("SHAPE", 3));
+  const char* config = std::getenv("CONFIG");
+  Case c(std::uint64_t(env_int("SEED", 777)), env_int("SHAPE", 3),
+         config ? config : HS_SOURCE_DIR "/configs/presets/random2d.yaml");
   solver::NonlinearSolver ns(*c.sp.problem, c.cfg.solver);
   replay(c, ns, env_int("FROM", 0), env_int("LOAD", 47));
 }
@@ -145,5 +150,25 @@ TEST_CASE("A target on the unstable segment of a fold is reported as a fold", "[
     const auto up = ns.solve(r.alpha * (1 + 1e-6));
     REQUIRE(up.converged);
     CHECK(p.max_displacement(ns.solution()) < target);
+  }
+}
+
+TEST_CASE("Under fixed gravity the path starts from the gravity state and keeps alpha positive", "[stability][fixed_load]") {
+  // configs/examples/multi_load2d.yaml (three tractions over a fixed gravity) at 20 shapes x 50
+  // load cases (scripts/bench_stability.sh's CONFIGS run): 15 of 1000 failed when the path started
+  // from u = 0 ("no progress" down to increments of 1/32 of the target; shape 19 load 3 alone
+  // fails so on the session-start build of 2026-11-25), and starting from gravity's equilibrium
+  // without the load steps took 492 of them to the target at alpha < 0 (shape 10 load 2 among
+  // them) and shape 8 load 14 to alpha = -135. Each alone must end stable on target at alpha > 0.
+  const std::vector<std::pair<int, int>> cases = {{19, 3}, {10, 2}, {8, 14}};
+  for (const auto& [shape_id, load_id] : cases) {
+    Case c(17, shape_id, HS_SOURCE_DIR "/configs/examples/multi_load2d.yaml");
+    REQUIRE(c.sp.problem->has_fixed_load());
+    const auto& lc = c.set(load_id);
+    solver::NonlinearSolver ns(*c.sp.problem, c.cfg.solver);
+    const auto r = ns.solve_for_target(lc.target);
+    INFO("shape " << shape_id << " load " << load_id << ": " << r.reason << " (" << r.newton_iterations << " its)");
+    CHECK(r.alpha > 0);
+    hstest::check_stable_on_target(*c.sp.problem, ns.solution(), r, lc.target, c.cfg.solver);
   }
 }

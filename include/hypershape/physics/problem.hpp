@@ -77,6 +77,9 @@ class Problem {
   double load_norm() const { return load_norm_; }
   /// The fixed load f_fixed (global vector), or null when no effect has one.
   Vec fixed_load() const { return fixed_load_.get(); }
+  /// True where an active effect loads the body without the load factor (a dead or follower load
+  /// with scale: fixed): then u = 0 is not an equilibrium at s = 0.
+  bool has_fixed_load() const;
   /// Re-runs the set-up of the load effects and reassembles f_ext and f_fixed, after a load effect was
   /// changed (e.g. GaussianTraction::set for the next load case). Collective.
   void reassemble_load();

@@ -162,6 +162,9 @@ class NonlinearSolver {
   Mat jacobian_matrix() const { return J_.get(); }
   const physics::Problem& problem() const { return problem_; }
 
+ public:
+  struct LoadExtremes;  ///< the load's extremes along a path (path_following.cpp)
+
  private:
   static PetscErrorCode form_function(SNES, Vec, Vec, void*);
   static PetscErrorCode form_jacobian(SNES, Vec, Mat, Mat, void*);
@@ -171,11 +174,34 @@ class NonlinearSolver {
   /// The guarded line search on W = X - lambda Y at load factor s, F = R(X, s): returns the
   /// accepted lambda (G = R(W, s)) or 0.
   double backtrack(Vec X, Vec Y, Vec F, double s, Vec W, Vec G);
-  bool newton(double s, SolveResult& r);
+  /// Newton's method on the SNES at load factor s from u_, converged when |R| <= atol + rtol (|s|
+  /// |f_ext| + fixed_norm) (checked on the true residual; rtol <= 0: the options' rtol).
+  bool newton(double s, SolveResult& r, double fixed_norm = 0, double rtol = 0);
+  /// With fixed loads (has_fixed_load) and u_ = 0, s_ = 0: the path's start (u = 0 is not an
+  /// equilibrium). Newton to the equilibrium under the fixed loads alone (on failure u_ = 0 again:
+  /// the path starts from rest), then load steps (alpha doubling) while max|u| falls as alpha
+  /// grows, so that displacement control leads alpha up. Adds the iterations to `its`. True if
+  /// a_ and negative_pivots_ are the tangent response of the state it leaves.
+  bool start_under_fixed_loads(double target, int& its);
+  /// A load-controlled step of the path's start from the state in u_/s_ to s_ + step (halved up
+  /// to three times where Newton fails), converged to path_rtol of |s f_ext| + fixed_norm. False
+  /// (u_, s_ unchanged) if none converged.
+  bool load_step(double step, double fixed_norm, int& its);
   TargetResult search_target(double target, double start);
   /// Displacement control from the current state to max|u| = target; `spent`: Newton
   /// iterations the target solve spent before (counted against newton_budget).
   TargetResult follow_path(double target, double start, int spent = 0);
+  /// Where a path starts: the current state; rest, giving up at its first failed increment (a
+  /// problem with fixed loads tries that first); the fixed loads' equilibrium
+  /// (start_under_fixed_loads).
+  enum class PathStart { here, rest_once, fixed_loads };
+  /// follow_path's increments from the start `how`.
+  TargetResult path(double target, double start, int spent, PathStart how);
+  /// The path's first increment from max|u| = d towards `target` (`fresh`: a load case's start).
+  double first_step(double target, double d, bool fresh) const;
+  /// After the last increment reached `d` = target: checks the state's own tangent; true (with
+  /// t.reason: a fold or a loss of stability) if it is not positive definite.
+  bool unstable_on_target(double d, const LoadExtremes& extremes, TargetResult& t);
   /// One increment of the path from the equilibrium in u_/s_ to max|u| = d_next: the tangent
   /// predictor (a_ holds K^-1 f_ext there) and the corrector, to rtol if `last`, else path_rtol.
   bool increment(double d_next, bool last, int& its, std::string& why);
@@ -186,7 +212,7 @@ class NonlinearSolver {
   /// The path's result from the state it ended in (`at_target`: its last increment reached
   /// the target): max|u|, alpha, inertia, and the converged state's final check.
   void finish_path(TargetResult& t, bool at_target);
-  /// One corrector: Newton on (u, alpha) for max|u| = d (or alpha fixed when d < 0) from the
+  /// One corrector: Newton on (u, alpha) for max|u| = d from the
   /// current iterate in u_/s_; returns false with `why` set on failure. Leaves in `a_` the
   /// tangent response K^-1 f_ext of its last factorisation (the next predictor).
   bool correct(double d, double rtol, int& its, std::string& why);

@@ -1,5 +1,7 @@
 /// Effect "neo_hookean": the seed paper's compressible Neo-Hookean material (appendix A).
-/// Keys: E (Young's modulus, > 0), nu (Poisson's ratio, in (-1, 0.5)), the modulus field's keys.
+/// Keys: E (Young's modulus, > 0), nu (Poisson's ratio, in (-1, 0.5)), dilatation (pointwise,
+/// the default, or mean: the volumetric energy on each cell's mean dilatation, mean_dilatation.cpp),
+/// the modulus field's keys.
 #include "hypershape/physics/neo_hookean.hpp"
 
 #include "hypershape/physics/material_params.hpp"
@@ -10,6 +12,21 @@ EffectPtr make_neo_hookean(double E, double nu, ScalarFunction field) {
   return make_young_poisson_material<NeoHookean>("neo_hookean", E, nu, std::move(field));
 }
 
-void register_neo_hookean() { register_young_poisson_material<NeoHookean>("neo_hookean", "compressible Neo-Hookean material (seed, appendix A)"); }
+void register_neo_hookean() {
+  register_effect(
+      "neo_hookean",
+      [](const core::Params& p, int dim) {
+        const YoungPoisson m = young_poisson(p);
+        const std::string dilatation = p.has("dilatation") ? p.text("dilatation") : "pointwise";
+        if (dilatation != "pointwise" && dilatation != "mean")
+          p.fail("dilatation", "'" + dilatation + "' is not one of: pointwise, mean");
+        return dilatation == "mean" ? make_neo_hookean_mean_dilatation(m.E, m.nu, modulus_field(p, dim))
+                                    : make_neo_hookean(m.E, m.nu, modulus_field(p, dim));
+      },
+      "compressible Neo-Hookean material (seed, appendix A); keys: E > 0, nu in (-1, 0.5), dilatation: "
+      "pointwise (default) or mean (lambda/2 ln^2 of each cell's mean dilatation: locking-free on P2 "
+      "meshes near incompressibility; on P1 the same as pointwise)" +
+          modulus_field_help());
+}
 
 }  // namespace hypershape::physics
