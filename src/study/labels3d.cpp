@@ -56,9 +56,10 @@ Discretisation parse_discretisation(const std::string& spec) {
     else if (key == "load") d.load_size = number();
     else if (key == "grading") d.grading = number();
     else if (key == "label_on") d.label_on = value;
+    else if (key == "dilatation" && (value == "pointwise" || value == "mean")) d.dilatation = value;
     else
       throw std::invalid_argument("discretisation '" + spec + "': unknown key '" + key +
-                                  "' (allowed: h, surface_h, interior_h, rim, load, grading, label_on)");
+                                  "' (allowed: h, surface_h, interior_h, rim, load, grading, label_on, dilatation=pointwise|mean)");
   }
   if (!(d.surface_h > 0 && d.interior_h > 0 && d.grading > 0))
     throw std::invalid_argument("discretisation '" + spec + "': h, surface_h, interior_h, grading must be > 0");
@@ -163,7 +164,9 @@ Solved solve(const Scene& s, const Discretisation& d, double alpha, std::optiona
   t0 = core::now_seconds();
   physics::SpaceOptions so;
   so.degree = 2;
-  auto sp = factory::make_shape_problem(PETSC_COMM_SELF, s.cfg, o.shape, s.lc, so);
+  config::DatasetConfig cfg = s.cfg;
+  for (auto i : cfg.scene.find("neo_hookean")) cfg.scene.effects[i].params["dilatation"] = std::string(d.dilatation);
+  auto sp = factory::make_shape_problem(PETSC_COMM_SELF, cfg, o.shape, s.lc, so);
   const physics::Problem& problem = *sp.problem;
   set_linear_solver(true);
   solver::NonlinearSolver nl(problem, s.cfg.solver, kPrefix);

@@ -26,11 +26,14 @@ struct Discretisation {
   /// A per-load-case mesh's label lives on this discretisation's mesh (the shape's stored
   /// nodes): the solution is sampled onto its vertices. Empty: on its own vertices.
   std::string label_on;
+  /// The material's volumetric energy: "pointwise" (the seed's) or "mean" (neo_hookean's
+  /// dilatation: mean, the P2/P0 mean-dilatation element).
+  std::string dilatation = "pointwise";
   bool per_load() const { return load_size > 0; }
 };
 
 /// Parses "name:key=value,key=value" (keys surface_h, interior_h, h (both), rim, load,
-/// grading, label_on). Throws std::invalid_argument naming the bad key.
+/// grading, label_on, dilatation). Throws std::invalid_argument naming the bad key.
 Discretisation parse_discretisation(const std::string& spec);
 
 struct Options {
