@@ -3,6 +3,7 @@
 # the ball and on Random3D shape 0 (the random3d preset's problem at alpha 5), the ladder that
 # states its error, and the options a dataset could label with.
 #   scripts/study_labels3d.sh [ball|r3d-0 ...]      (default: both; ~15-30 min each on a shared 2-core VM)
+#   DILATATION=mean scripts/study_labels3d.sh        (the mean-dilatation element's study)
 # Output: results/labels3d/<scene>.json, results/labels3d/<scene>_ref*.h5 (for
 # scripts/check_labels3d_dolfinx.py), and the tables (scripts/labels3d_table.py).
 set -euo pipefail
@@ -12,6 +13,25 @@ export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
 scenes=("$@")
 [ ${#scenes[@]} -eq 0 ] && scenes=(ball r3d-0)
 mkdir -p results/labels3d
+if [ "${DILATATION:-}" = mean ]; then
+  # The same with the mean-dilatation element (docs/ACCURACY.md, "3D labels with the
+  # mean-dilatation element"): its reference ladder, the pointwise reference beside it, and the
+  # options: DILATATION=mean scripts/study_labels3d.sh -> results/labels3d/<scene>_mean.json
+  m=",dilatation=mean"
+  for scene in "${scenes[@]}"; do
+    "$build/study_labels3d" --scene "$scene" --reference refm0.0125 \
+      -d refm0.0125:surface_h=0.1,interior_h=0.3,rim=0.0125,load=0.0125,grading=0.4$m \
+      -d ref0.0125:surface_h=0.1,interior_h=0.3,rim=0.0125,load=0.0125,grading=0.4 \
+      -d refm0.025:surface_h=0.1,interior_h=0.3,rim=0.025,load=0.025,grading=0.4$m \
+      -d refm0.05:surface_h=0.1,interior_h=0.3,rim=0.05,load=0.05,grading=0.4$m \
+      -d u0.3:h=0.3 -d u0.3m:h=0.3$m -d u0.25m:h=0.25$m -d u0.2m:h=0.2$m \
+      -d rim0.3m:h=0.3,rim=0.075$m -d rim0.25m:h=0.25,rim=0.075$m -d rim0.2m:h=0.2,rim=0.075$m \
+      -d rim0.2m5:h=0.2,rim=0.05$m -d u0.2:h=0.2 -d rim0.2:h=0.2,rim=0.075 -d s0.15rimm:surface_h=0.15,interior_h=0.3,rim=0.05$m \
+      -d s0.1m:surface_h=0.1,interior_h=0.3$m -d s0.1rimm:surface_h=0.1,interior_h=0.3,rim=0.05$m \
+      --out "results/labels3d/${scene}_mean.json" 2>&1 | tee "results/labels3d/${scene}_mean.log"
+  done
+  exit 0
+fi
 for scene in "${scenes[@]}"; do
   # The reference ladder (local sizes halved at the clamp rim and at p_N; the surface as drawn,
   # 0.1) and the options. ref0.0125 is the reference; ref0.025 and ref0.05 give its error.
