@@ -180,21 +180,8 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
     // (8 shapes x 25 load cases, P1): 8 states accepted unrefreshed, the increments after them
     // failed 32 times; with the iteration 14.1 -> 13.3 Newton iterations per load case.
     const bool refreshed = k > 0 || rtol <= opt_.rtol;
-    if (refreshed && rn <= opt_.atol + rtol * std::abs(s_) * fnorm && std::abs(g) <= gtol) {
-      // The final state's stability check needs the inertia of its own tangent: with a kept
-      // factor (of an earlier state) it is factorised here, once per target solve.
-      if (rtol <= opt_.rtol && opt_.tangent.reuse && !factorise_here()) {
-        why = "tangent factorisation at the final state failed";
-        return false;
-      }
-      // With multigrid no factor gives the inertia: the smallest eigenvalue's sign does; with LU
-      // (a follower load) the symmetric part's LDL^T does.
-      if (rtol <= opt_.rtol && (tangent_->multigrid() || tangent_->lu()) && !check_stability_here()) {
-        why = "tangent at the final state could not be formed or factorised";
-        return false;
-      }
-      return true;
-    }
+    if (refreshed && rn <= opt_.atol + rtol * std::abs(s_) * fnorm && std::abs(g) <= gtol)
+      return rtol > opt_.rtol || inertia_at_final_state(why);
     if (k == opt_.max_newton) {
       why = "no convergence in " + std::to_string(opt_.max_newton) + " Newton iterations";
       return false;
@@ -239,6 +226,22 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
     HS_PETSC(VecWAXPY(r_, (1.0 - lambda) * dalpha, problem_.load_at(u_), b_));  // R(w, s_)
     HS_PETSC(VecNorm(r_, NORM_2, &rn));
   }
+}
+
+bool NonlinearSolver::inertia_at_final_state(std::string& why) {
+  // The final state's stability check needs the inertia of its own tangent: with a kept factor
+  // (of an earlier state) it is factorised here, once per target solve.
+  if (opt_.tangent.reuse && !factorise_here()) {
+    why = "tangent factorisation at the final state failed";
+    return false;
+  }
+  // With multigrid no factor gives the inertia: the smallest eigenvalue's sign does; with LU (a
+  // follower load) the symmetric part's LDL^T does.
+  if ((tangent_->multigrid() || tangent_->lu()) && !check_stability_here()) {
+    why = "tangent at the final state could not be formed or factorised";
+    return false;
+  }
+  return true;
 }
 
 bool NonlinearSolver::increment(double d_next, bool last, int& its, std::string& why) {

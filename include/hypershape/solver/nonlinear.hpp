@@ -216,6 +216,9 @@ class NonlinearSolver {
   /// current iterate in u_/s_; returns false with `why` set on failure. Leaves in `a_` the
   /// tangent response K^-1 f_ext of its last factorisation (the next predictor).
   bool correct(double d, double rtol, int& its, std::string& why);
+  /// At the path's final state (converged to rtol): its tangent's inertia where the corrector's
+  /// last factor does not give it (a kept factor, multigrid, LU). False with `why` on failure.
+  bool inertia_at_final_state(std::string& why);
   /// Node of the largest |u| and the vector c with c . v = (u_k / |u_k|) . v_k; when u = 0,
   /// picked from `fallback`. Returns |u_k|. Collective.
   double control_direction(Vec u, Vec fallback, Vec c);
