@@ -15,6 +15,9 @@
 #   pressure       + a fixed dead pressure 2 on the whole boundary
 #   mooney_rivlin  Mooney-Rivlin (C1 60, C2 24, kappa 8333: mu, K of E 500, nu 0.49) instead
 #   linear_elastic linear elasticity instead (one linear solve per load case: alpha exact)
+#   follower       + a fixed follower pressure 2 on the whole boundary (LU solves)
+#   p2, p2_mean    P2 on the same mesh, the pointwise Neo-Hookean and dilatation: mean (compare
+#                  p2_mean with p2, not with paper)
 #   organ_pressure (3D presets only) + configs/examples/organ_pressure3d.yaml's pressure, fixed at
 #                  its middle value 0.65 on the facets at z >= 0.2
 # PRESET=aug_liver (or random3d, liver, one_liver) runs a 3D slice of that preset instead: its
@@ -41,7 +44,7 @@ if [ $dim = 3 ]; then : "${VARIANTS:=paper organ_pressure}"; fi  # the others' v
 head="preset: $preset
 name: bench_effects
 shapes: {count: $shapes}
-loads: {count: $loads$([ $dim = 3 ] && echo ", target: [0.2, 0.5]")}
+loads: {count: $loads$(if [ $dim = 3 ]; then echo ", target: [0.2, 0.5]"; fi)}
 output: {shard_size: 2}"
 nh="  neo_hookean: {E: 500, nu: 0.49}"
 patch="  dirichlet_patch: {radius: $([ $dim = 3 ] && echo 0.4 || echo 0.5)}"
@@ -68,6 +71,9 @@ variant supports3 "$nh" "$patch" "  dirichlet: [{box: [-3, -3, -0.85, 3]}, {cent
 variant pressure "$nh" "$patch" "$traction" "  pressure: {value: 2, scale: fixed}"
 variant mooney_rivlin "  mooney_rivlin: {C1: 60, C2: 24, kappa: 8333}" "$patch" "$traction"
 variant linear_elastic "  linear_elastic: {E: 500, nu: 0.49}" "$patch" "$traction"
+variant follower "$nh" "$patch" "$traction" "  pressure: {value: 2, follower: true, scale: fixed}"
+variant p2 "$nh" "$patch" "$traction" "mesh: {degree: 2}"
+variant p2_mean "  neo_hookean: {E: 500, nu: 0.49, dilatation: mean}" "$patch" "$traction" "mesh: {degree: 2}"
 if [ $dim = 3 ]; then
   variant organ_pressure "$nh" "$patch" "$traction" "  pressure: {value: 0.65, box: [-3, -3, 0.2, 3, 3, 3], scale: fixed}"
 fi
@@ -87,7 +93,10 @@ label = {"paper": "the preset (neo_hookean, dirichlet_patch, gaussian_traction)"
          "supports3": "+ 2 fixed dirichlet regions (3 supports)", "pressure": "+ fixed dead pressure 2 (whole boundary)",
          "mooney_rivlin": "Mooney-Rivlin instead (C1 60, C2 24, kappa 8333: the same mu, K)",
          "linear_elastic": "linear elasticity instead (one linear solve)",
-         "organ_pressure": "+ fixed dead pressure 0.65 on the upper side (z >= 0.2; organ_pressure3d's)"}
+         "organ_pressure": "+ fixed dead pressure 0.65 on the upper side (z >= 0.2; organ_pressure3d's)",
+         "follower": "+ fixed follower pressure 2 (whole boundary; LU solves)",
+         "p2": "P2 on the same mesh (pointwise Neo-Hookean)",
+         "p2_mean": "P2, neo_hookean dilatation: mean (compare with P2)"}
 rows = {}
 for n in names:
     per_load, newton, conv = [], [], []
