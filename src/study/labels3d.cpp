@@ -56,8 +56,12 @@ Discretisation parse_discretisation(const std::string& spec) {
     else if (key == "load") d.load_size = number();
     else if (key == "grading") d.grading = number();
     else if (key == "label_on") d.label_on = value;
-    else if (key == "dilatation" && (value == "pointwise" || value == "mean")) d.dilatation = value;
-    else
+    else if (key == "dilatation") {
+      if (value != "pointwise" && value != "mean")
+        throw std::invalid_argument("discretisation '" + spec + "': dilatation must be pointwise or mean, not '" +
+                                    value + "'");
+      d.dilatation = value;
+    } else
       throw std::invalid_argument("discretisation '" + spec + "': unknown key '" + key +
                                   "' (allowed: h, surface_h, interior_h, rim, load, grading, label_on, dilatation=pointwise|mean)");
   }
