@@ -16,6 +16,7 @@ the label's vertices (nodal and lumped-volume weighted), the error of max|u|, er
 import argparse
 import json
 import math
+import sys
 from pathlib import Path
 
 
@@ -42,6 +43,9 @@ def ladder(res, names=("ref0.05", "ref0.025")):
 def rows(res):
     out = []
     for r in res["results"]:
+        if "dofs" not in r:  # an option whose mesh could not be made: its reason is in the JSON
+            print(f"{res['scene']}: {r['name']} {r['reason']}", file=sys.stderr)
+            continue
         e = r.get("error", {})
         l2 = e.get("rel_l2_volume")
         out.append({

@@ -26,6 +26,7 @@ if [ "${DILATATION:-}" = mean ]; then
       -d refm0.05:surface_h=0.1,interior_h=0.3,rim=0.05,load=0.05,grading=0.4$m \
       -d u0.3:h=0.3 -d u0.3m:h=0.3$m -d u0.25m:h=0.25$m -d u0.2m:h=0.2$m \
       -d rim0.3m:h=0.3,rim=0.075$m -d rim0.25m:h=0.25,rim=0.075$m -d rim0.2m:h=0.2,rim=0.075$m \
+      -d rim0.3m15:h=0.3,rim=0.15$m -d rim0.3m10:h=0.3,rim=0.1$m -d rim0.25m10:h=0.25,rim=0.1$m \
       -d rim0.2m5:h=0.2,rim=0.05$m -d u0.2:h=0.2 -d rim0.2:h=0.2,rim=0.075 -d s0.15rimm:surface_h=0.15,interior_h=0.3,rim=0.05$m \
       -d s0.1m:surface_h=0.1,interior_h=0.3$m -d s0.1rimm:surface_h=0.1,interior_h=0.3,rim=0.05$m \
       --out "results/labels3d/${scene}_mean.json" 2>&1 | tee "results/labels3d/${scene}_mean.log"

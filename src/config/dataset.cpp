@@ -203,7 +203,10 @@ void parse_material(const YamlBlock& b, MaterialConfig& m) {
   if (!(m.E > 0)) b.fail("E", "must be > 0");
   if (b.has("nu")) m.nu = b.number("nu");
   if (!(m.nu > -1 && m.nu < 0.5)) b.fail("nu", "must be in (-1, 0.5)");
-  b.allowed("E, nu");
+  if (b.has("dilatation")) m.dilatation = b.text("dilatation");
+  if (m.dilatation != "pointwise" && m.dilatation != "mean")
+    b.fail("dilatation", "'" + m.dilatation + "' is not one of: pointwise, mean");
+  b.allowed("E, nu, dilatation");
   b.check_all_used();
 }
 
@@ -218,7 +221,9 @@ physics::SceneSpec shorthand_scene(const DatasetConfig& c, const std::string& so
   auto add = [&](const char* name, std::map<std::string, physics::ParamValue> params) {
     s.effects.push_back({name, name, std::string("effects.") + name, std::move(params), true, false, {}, 0});
   };
-  add("neo_hookean", {{"E", c.material.E}, {"nu", c.material.nu}});
+  std::map<std::string, physics::ParamValue> material{{"E", c.material.E}, {"nu", c.material.nu}};
+  if (c.material.dilatation != "pointwise") material["dilatation"] = c.material.dilatation;  // else: as before
+  add("neo_hookean", std::move(material));
   if (c.shapes.dirichlet_radius > 0) add("dirichlet_patch", {{"radius", c.shapes.dirichlet_radius}});
   add("gaussian_traction", {{"gamma", c.loads.gamma}});
   return s;

@@ -363,7 +363,18 @@ json run(const Options& opt) {
     if (!d.label_on.empty() && !solved.contains(d.label_on))
       throw std::invalid_argument(d.name + ": label_on '" + d.label_on + "' must come earlier");
     std::cerr << fmt::format("[labels3d] {} {} ...\n", opt.scene, d.name);
-    auto s = std::make_unique<Solved>(solve(scene, d, opt.alpha, opt.time_target ? target : std::nullopt));
+    std::unique_ptr<Solved> s;
+    try {
+      s = std::make_unique<Solved>(solve(scene, d, opt.alpha, opt.time_target ? target : std::nullopt));
+    } catch (const std::exception& e) {
+      // An option whose mesh cannot be made (e.g. a remeshing that folds a triangle) is a result
+      // of the study, not its end; without the reference there is nothing to compare.
+      if (d.name == opt.reference) throw;
+      set_linear_solver(false);
+      std::cerr << fmt::format("[labels3d]   {} failed: {}\n", d.name, e.what());
+      out["results"].push_back({{"name", d.name}, {"converged", false}, {"reason", std::string("failed: ") + e.what()}});
+      continue;
+    }
     if (d.name == opt.reference) target = s->max_u;
     if (!opt.write_dir.empty()) write_solved(opt.write_dir + "/" + opt.scene + "_" + d.name + ".h5", scene, *s, opt.alpha);
     solved.emplace(d.name, std::move(s));

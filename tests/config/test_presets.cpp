@@ -105,7 +105,7 @@ TEST_CASE("mesh.h: a 3D mesh coarser than its shape, checked", "[config][presets
   CHECK(c.shapes.mesh_h == 0.3);
   CHECK(c.degree == 2);
   // The 3D presets set it (merged under an override of the degree alone); 2D ones do not.
-  CHECK(by_name("preset: random3d\nmesh: {degree: 1}\n").shapes.mesh_h == 0.3);
+  CHECK(by_name("preset: random3d\nmesh: {degree: 1}\n").shapes.mesh_h == 0.25);
   CHECK(by_name("preset: liver\n").shapes.mesh_h == 0.2);
   CHECK(by_name("preset: random2d\n").shapes.mesh_h == 0.0);
   CHECK_THAT(error_of("preset: random2d\nmesh: {h: 0.1}\n"),
@@ -113,4 +113,28 @@ TEST_CASE("mesh.h: a 3D mesh coarser than its shape, checked", "[config][presets
   CHECK_THAT(error_of("preset: random3d\nshapes: {h: 0.1}\nmesh: {h: 0.05}\n"),
              Catch::StartsWith("mesh.h") && Catch::Contains("[shapes.h = 0.1, 0.5]"));
   CHECK_THAT(error_of("preset: random3d\nmesh: {h: big}\n"), Catch::StartsWith("mesh.h"));
+}
+
+TEST_CASE("random3d labels with the mean dilatation; material.dilatation is the shorthand, checked",
+          "[config][presets]") {
+  auto dilatation = [](const config::DatasetConfig& c) -> std::string {
+    for (auto i : c.scene.find("neo_hookean"))
+      if (auto it = c.scene.effects[i].params.find("dilatation"); it != c.scene.effects[i].params.end())
+        return std::get<std::string>(it->second);
+    return "(none)";
+  };
+  const auto r3 = by_name("preset: random3d\n");
+  CHECK(r3.material.dilatation == "mean");
+  CHECK(dilatation(r3) == "mean");
+  CHECK(r3.shapes.mesh_h == 0.25);
+  CHECK(r3.shapes.rim_size == 0.1);
+  // The other presets' scenes are what they were: no dilatation key at all.
+  CHECK(dilatation(by_name("preset: random2d\n")) == "(none)");
+  CHECK(dilatation(by_name("preset: aug_liver\n")) == "(none)");
+  // A config's own material wins; its own effects replace the shorthand (pointwise unless said).
+  CHECK(dilatation(by_name("preset: random3d\nmaterial: {dilatation: pointwise}\n")) == "(none)");
+  CHECK(dilatation(by_name("preset: random3d\neffects:\n  neo_hookean: {E: 500, nu: 0.49}\n"
+                           "  dirichlet_patch: {radius: 0.4}\n  gaussian_traction: {gamma: 0.1}\n")) == "(none)");
+  CHECK_THAT(error_of("preset: random2d\nmaterial: {dilatation: avg}\n"),
+             Catch::StartsWith("material.dilatation") && Catch::Contains("pointwise, mean"));
 }

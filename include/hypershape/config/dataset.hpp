@@ -81,6 +81,9 @@ struct LoadsConfig {
 struct MaterialConfig {
   double E = 500.0;
   double nu = 0.49;
+  /// neo_hookean's volumetric term: "pointwise" (the seed's) or "mean" (each cell's mean
+  /// dilatation: locking-free on P2; the random3d preset's).
+  std::string dilatation = "pointwise";
 };
 
 struct RepresentationsConfig {
