@@ -95,6 +95,7 @@ Scene make_scene(const std::string& name) {
   if (name != "r3d-0") throw std::invalid_argument("scene '" + name + "' (allowed: ball, r3d-0)");
   factory::ShapeConfig c = factory::shape_config(s.cfg, 0);
   c.mesh_h = c.h;  // the surface as drawn
+  c.surface_h = 0, c.rim_size = 0;  // no remeshing: the preset's own (rim) would redraw shape 0
   const factory::ShapeSample shape = factory::make_shape(c, std::nullopt, s.cfg.seed, 0);
   s.surface = shape.boundary;
   s.p_d = shape.dirichlet_center;
