@@ -16,8 +16,14 @@ namespace hypershape::study::accuracy {
 std::string fmt_g(double v) { return fmt::format("{:g}", v); }
 
 config::DatasetConfig scene_config(const SceneSpec& s, const std::string& override_yaml) {
-  return config::parse_dataset_text("preset: " + s.preset + "\n" + override_yaml + "\n",
-                                    "<study_accuracy --override>");
+  // The study refines uniformly with the seed's pointwise material: the random3d preset's clamp
+  // rim and mean dilatation (since 2026-11-25) are measured by study_labels3d instead.
+  const bool r3 = s.preset == "random3d" && override_yaml.find("material") == std::string::npos;
+  auto c = config::parse_dataset_text("preset: " + s.preset + "\n" + override_yaml + "\n" +
+                                          (r3 ? "material: {dilatation: pointwise}\n" : ""),
+                                      "<study_accuracy --override>");
+  if (s.preset == "random3d") c.shapes.rim_size = 0, c.shapes.surface_h = 0;
+  return c;
 }
 
 double preset_mesh_h(const config::DatasetConfig& cfg) { return std::max(cfg.shapes.h, cfg.shapes.mesh_h); }
