@@ -38,7 +38,9 @@ echo "ok   scene mesh.rim on a circle rejected: $(tail -1 <<<"$msg")"
 
 # r3d-0 is Random3D shape 0 as drawn: its patch centre and load case stay what the study's
 # tables were measured on, whatever the random3d preset's own mesh (a rim there redraws shape 0).
-"$study" --scene r3d-0 --reference a -d a:h=0.3 --out "$work/r.json" 2> "$work/r.txt" ||
+# An option whose mesh cannot be made (rim 0.05 on a 0.3 surface folds a triangle there) is
+# recorded as failed and the study goes on.
+"$study" --scene r3d-0 --reference a -d a:h=0.3 -d bad:h=0.3,rim=0.05 -d b:h=0.3 --out "$work/r.json" 2> "$work/r.txt" ||
   { echo "FAIL: study_labels3d r3d-0"; cat "$work/r.txt"; exit 1; }
 /usr/bin/python3 - "$work/r.json" <<'PY' || exit 1
 import json, sys
@@ -47,7 +49,11 @@ want = {"p_D": [0.7812941698929541, -0.45478935312820246, 0.0683569092108644],
         "p_N": [0.6654219894171893, 0.6512010878199574, 0.2512306840294596]}
 bad = [k for k, v in want.items() if max(abs(a - b) for a, b in zip(d[k], v)) > 1e-12]
 print(("FAIL " if bad else "ok   ") + f"r3d-0 is shape 0 as the tables measured it (p_D {d['p_D']})")
-sys.exit(1 if bad else 0)
+r = {x["name"]: x for x in d["results"]}
+went_on = (not r["bad"]["converged"] and r["bad"]["reason"].startswith("failed: remesh_surface")
+           and r["b"]["converged"] and r["b"]["error"]["rel_l2_volume"] < 1e-12)
+print(("ok   " if went_on else "FAIL ") + f"an option whose mesh fails is recorded ({r['bad']['reason'][:60]}...) and the study goes on")
+sys.exit(1 if bad or not went_on else 0)
 PY
 
 if ! "$study" --scene ball --reference fine -d fine:h=0.2 -d coarse:h=0.3 \
