@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
-# Benchmark of the data factory: a Random2D slice (default 20 shapes x 50 load cases, the
-# preset's h and 128^2 grids) generated on 1 and on 2 ranks, alternately, REPEATS times (default
-# 3). Prints the median load cases per second of each, the per-phase split and peak memory per
-# rank (of the median run), the 2-rank efficiency (ratio of the medians) and the projected time
-# of the full Random2D (1000 x 50); writes every run's figures as JSON.
+# Benchmark of the data factory: a slice of a preset (PRESET, default random2d; default 20 shapes
+# x 50 load cases at the preset's discretisation and grids) generated on 1 and on 2 ranks,
+# alternately, REPEATS times (default 3). Prints the median load cases per second of each, the
+# per-phase split and peak memory per rank (of the median run), the 2-rank efficiency (ratio of
+# the medians) and the projected time of the full preset (its shapes.count x loads.count, e.g.
+# Random2D 1000 x 50, Random3D 1000 x 20); writes every run's figures as JSON.
 #   scripts/bench_generate.sh [SHAPES] [LOADS] [REPEATS]    (JSON: results/bench_generate.json)
+#   PRESET=random3d scripts/bench_generate.sh 10 20 1       (a Random3D slice of 200 load cases)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 shapes=${1:-20} loads=${2:-50} repeats=${3:-3}
@@ -12,8 +14,8 @@ export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OPENBLAS_NUM_TH
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 cat > "$work/slice.yaml" <<YAML
-preset: random2d
-name: bench_random2d
+preset: ${PRESET:-random2d}
+name: bench_${PRESET:-random2d}
 shapes: {count: $shapes}
 loads: {count: $loads}
 output: {shard_size: 2}
@@ -24,19 +26,23 @@ for ((k = 0; k < repeats; ++k)); do
   echo "run $((k + 1))/$repeats done" >&2
 done
 mkdir -p results
-/usr/bin/python3 - "$work" "$shapes" "$loads" "$repeats" <<'PY'
+/usr/bin/python3 - "$work" "$shapes" "$loads" "$repeats" "configs/presets/${PRESET:-random2d}.yaml" <<'PY'
 import json, statistics, sys
+import yaml
 work, shapes, loads, repeats = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4])
+preset = yaml.safe_load(open(sys.argv[5]))
+name = preset["name"]
+full = preset["shapes"].get("count", 1) * preset["loads"]["count"]  # load cases of the full preset
 runs = {n: [json.load(open(f"{work}/np{n}-{k}/reports/task-000-of-001.json")) for k in range(repeats)] for n in (1, 2)}
 rates = {n: [x["load_cases"]["per_second"] for x in runs[n]] for n in (1, 2)}
 rate = {n: statistics.median(rates[n]) for n in (1, 2)}
 # The run whose rate is the median (the lower middle one for an even count) stands for its rank count.
 r = {n: sorted(runs[n], key=lambda x: x["load_cases"]["per_second"])[(repeats - 1) // 2] for n in (1, 2)}
-out = {"slice": {"shapes": shapes, "load_cases_per_shape": loads}, "repeats": repeats,
+out = {"preset": name, "full_load_cases": full, "slice": {"shapes": shapes, "load_cases_per_shape": loads}, "repeats": repeats,
        "rates_per_run": rates, "median_rate": rate, "runs": runs}
 out["efficiency_2_ranks"] = rate[2] / (2 * rate[1])
-out["projected_hours_random2d_1000x50"] = {n: 50000 / rate[n] / 3600 for n in (1, 2)}
-out["projected_hours_2_ranks_range"] = [50000 / max(rates[2]) / 3600, 50000 / min(rates[2]) / 3600]
+out["projected_hours_full"] = {n: full / rate[n] / 3600 for n in (1, 2)}
+out["projected_hours_2_ranks_range"] = [full / max(rates[2]) / 3600, full / min(rates[2]) / 3600]
 # Where the 2-rank run loses against twice the 1-rank rate, from the median runs: the work done
 # per load case (phase seconds summed over ranks; > 1: the ranks slow each other down, sharing
 # the machine), and the time ranks sit idle at the end of the slice (shards are handed out one at
@@ -46,20 +52,20 @@ busy = {n: sum(r[n]["seconds"]["phases_summed_over_groups"].values()) for n in (
 out["work_per_load_case_2_vs_1"] = busy[2] / busy[1]
 out["idle_share_2_ranks"] = 1 - busy[2] / (2 * r[2]["seconds"]["wall"])
 json.dump(out, open("results/bench_generate.json", "w"), indent=1)
-print(f"Random2D slice: {shapes} shapes x {loads} load cases, {repeats} runs per rank count (alternated)")
+print(f"{name} slice: {shapes} shapes x {loads} load cases, {repeats} runs per rank count (alternated)")
 for n in (1, 2):
     print(f"{n} rank(s): load cases/s per run {', '.join(f'{x:.2f}' for x in rates[n])}; median {rate[n]:.2f}")
 print("\nThe median run of each:")
-print("| ranks | load cases/s | wall s | converged | failed | Newton it./case | peak RSS MiB/rank | full Random2D (h) |")
+print(f"| ranks | load cases/s | wall s | converged | failed | Newton it./case | peak RSS MiB/rank | full {name}, {full} load cases (h) |")
 print("|---|---|---|---|---|---|---|---|")
 for n in (1, 2):
     x = r[n]
     lc = x["load_cases"]["converged"] + x["load_cases"]["failed"]
     print(f"| {n} | {rate[n]:.2f} | {x['seconds']['wall']:.1f} | {x['load_cases']['converged']} | {x['load_cases']['failed']} "
           f"| {x['solver']['newton_iterations'] / max(lc, 1):.1f} | {', '.join(f'{m:.0f}' for m in x['peak_rss_mib_per_rank'])} "
-          f"| {out['projected_hours_random2d_1000x50'][n]:.2f} |")
-print(f"2 ranks: {100 * out['efficiency_2_ranks']:.0f}% of twice the 1-rank rate (medians); full Random2D on 2 ranks: "
-      f"{out['projected_hours_random2d_1000x50'][2]:.2f} h (runs: {out['projected_hours_2_ranks_range'][0]:.2f}-"
+          f"| {out['projected_hours_full'][n]:.2f} |")
+print(f"2 ranks: {100 * out['efficiency_2_ranks']:.0f}% of twice the 1-rank rate (medians); full {name} on 2 ranks: "
+      f"{out['projected_hours_full'][2]:.2f} h (runs: {out['projected_hours_2_ranks_range'][0]:.2f}-"
       f"{out['projected_hours_2_ranks_range'][1]:.2f} h)")
 print(f"2 ranks lose {100 * (out['work_per_load_case_2_vs_1'] - 1):.1f}% to more work per load case (the ranks share "
       f"the machine) and {100 * out['idle_share_2_ranks']:.1f}% to time outside the phases (start-up, and the end of the slice: shards handed "
