@@ -30,7 +30,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> specs;
   std::string out = "results/labels3d.json";
   CLI::App app{"3D label error against a converged reference (docs/ACCURACY.md). Arguments after \"--\" go to PETSc."};
-  app.add_option("--scene", o.scene, "ball | r3d-0")->check(CLI::IsMember({"ball", "r3d-0"}));
+  app.add_option("--scene", o.scene, "ball | r3d-0 | r3d:SEED:SHAPE:LOAD (a load case of the random3d preset's factory)");
   app.add_option("--alpha", o.alpha, "traction scale (default 5)")->check(CLI::PositiveNumber);
   app.add_option("--reference", o.reference, "name of the reference discretisation")->required();
   app.add_option("-d,--discretisation", specs, "name:key=value,... (see the source header)")->required();

@@ -706,14 +706,17 @@ def error_estimates(ds, worst=5):
         return None
     a = np.array([r[2:] for r in rows])
     missing = int((a[:, 0] < 0).sum())  # -1: no estimate could be formed
+    inverted = int((a[:, 0] == -2).sum())  # -2: nor can be, the label inverts inside a cell
     rows = [r for r, k in zip(rows, a[:, 0] >= 0) if k]
     a = a[a[:, 0] >= 0]
     if not rows:
-        return {"load_cases": 0, "without_estimate": missing, "distribution_of_magnitude": {}, "worst_by_rel_l2": []}
+        return {"load_cases": 0, "without_estimate": missing, "inverted_in_a_cell": inverted,
+                "distribution_of_magnitude": {}, "worst_by_rel_l2": []}
     q = (50, 90, 99, 100)
     dist = {k: {f"p{p}": float(np.percentile(np.abs(a[:, i]), p)) for p in q} for i, k in enumerate(ERROR_ESTIMATES)}
     order = np.argsort(-a[:, 0])[:worst]
-    return {"load_cases": len(rows), "without_estimate": missing, "distribution_of_magnitude": dist,
+    return {"load_cases": len(rows), "without_estimate": missing, "inverted_in_a_cell": inverted,
+            "distribution_of_magnitude": dist,
             "worst_by_rel_l2": [{"shape": rows[i][0], "load": rows[i][1], "rel_l2": rows[i][2],
                                  "max_u": rows[i][3], "alpha": rows[i][4]} for i in order]}
 
@@ -721,7 +724,9 @@ def error_estimates(ds, worst=5):
 def print_error_estimates(e, out=sys.stdout):
     w = lambda s: print(s, file=out)  # noqa: E731
     w(f"  label error estimates over {e['load_cases']} converged load cases (|value| quantiles; "
-      f"{e['without_estimate']} without an estimate):")
+      f"{e['without_estimate']} without an estimate"
+      + (f", {e['inverted_in_a_cell']} of them because the label inverts inside a cell" if e.get("inverted_in_a_cell") else "")
+      + "):")
     for k, d in e["distribution_of_magnitude"].items():
         w(f"    {k:<24}" + "  ".join(f"{p} {v:.3g}" for p, v in d.items()))
     w("    worst load cases by rel_l2: " + ", ".join(

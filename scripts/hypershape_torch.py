@@ -106,7 +106,7 @@ class _Base(torch.utils.data.Dataset):
         per_shape = {sid: hd.shape_error_estimates(self.reader, sid) for sid in sorted({k[0] for k in self.index})}
         est = np.array([per_shape[sid][lid] for sid, lid in self.index]).reshape(-1, 3)
         if max_error is not None:
-            keep = (est[:, 0] >= 0) & (est[:, 0] <= max_error)  # -1 / NaN (no estimate): dropped
+            keep = (est[:, 0] >= 0) & (est[:, 0] <= max_error)  # -1, -2 / NaN (no estimate): dropped
             self.index = [k for k, ok in zip(self.index, keep) if ok]
             est = est[keep]
         self.error_estimates = est

@@ -4,6 +4,7 @@
 # states its error, and the options a dataset could label with.
 #   scripts/study_labels3d.sh [ball|r3d-0 ...]      (default: both; ~15-30 min each on a shared 2-core VM)
 #   DILATATION=mean scripts/study_labels3d.sh        (the mean-dilatation element's study)
+#   STUDY=large_loads | STUDY=share scripts/study_labels3d.sh   (alpha 15/30; pointwise_share)
 # Output: results/labels3d/<scene>.json, results/labels3d/<scene>_ref*.h5 (for
 # scripts/check_labels3d_dolfinx.py), and the tables (scripts/labels3d_table.py).
 set -euo pipefail
@@ -13,6 +14,31 @@ export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
 scenes=("$@")
 [ ${#scenes[@]} -eq 0 ] && scenes=(ball r3d-0)
 mkdir -p results/labels3d
+if [ "${STUDY:-}" = large_loads ] || [ "${STUDY:-}" = share ]; then
+  # docs/ACCURACY.md, "Labels that invert inside a cell": the preset's options at the dataset's
+  # large loads (alpha 15 and 30 on r3d-0), and neo_hookean's pointwise_share (share=) at alpha
+  # 5, each against refm0.025 (0.5-0.7% off refm0.0125 at alpha 5; the pointwise ref0.025 beside
+  # it). STUDY=large_loads | STUDY=share scripts/study_labels3d.sh [scenes]
+  m=",dilatation=mean"; r="rim=0.1"
+  ref="refm0.025:surface_h=0.1,interior_h=0.3,rim=0.025,load=0.025,grading=0.4$m"
+  for scene in "${scenes[@]}"; do
+    if [ "$STUDY" = large_loads ]; then
+      for a in 15 30; do
+        "$build/study_labels3d" --scene "$scene" --alpha $a --reference refm0.025 -d "$ref" \
+          -d ref0.025:surface_h=0.1,interior_h=0.3,rim=0.025,load=0.025,grading=0.4 \
+          -d rim0.25m10:h=0.25,$r$m -d rim0.25p10:h=0.25,$r -d u0.3:h=0.3 \
+          -d s0.2i0.3rim10m:surface_h=0.2,interior_h=0.3,$r$m --out "results/labels3d/${scene}_alpha$a.json"
+      done
+    else
+      "$build/study_labels3d" --scene "$scene" --alpha 5 --reference refm0.025 -d "$ref" \
+        -d rim0.25m10:h=0.25,$r$m -d rim0.25m10s05:h=0.25,$r$m,share=0.05 -d rim0.25m10s10:h=0.25,$r$m,share=0.1 \
+        -d rim0.25m10s20:h=0.25,$r$m,share=0.2 -d rim0.25p10:h=0.25,$r \
+        -d s0.2i0.3rim10m:surface_h=0.2,interior_h=0.3,$r$m -d s0.2i0.3rim10s05:surface_h=0.2,interior_h=0.3,$r$m,share=0.05 \
+        --out "results/labels3d/${scene}_share_alpha5.json"
+    fi
+  done
+  exit 0
+fi
 if [ "${DILATATION:-}" = mean ]; then
   # The same with the mean-dilatation element (docs/ACCURACY.md, "3D labels with the
   # mean-dilatation element"): its reference ladder, the pointwise reference beside it, and the

@@ -40,8 +40,9 @@ LabelErrorSummary LabelErrors::summary(const std::vector<std::int8_t>& status) c
   for (std::size_t k = 0; k < rel_l2_.size() && k < status.size(); ++k) {
     if (!status[k]) continue;
     const double v = rel_l2_[k];
-    if (v < 0) {  // -1: no estimate could be formed
+    if (v < 0) {  // -1: no estimate could be formed; -2: nor can be, the label inverts in a cell
       s.missing += 1;
+      s.inverted += v == inverted_label;
       continue;
     }
     s.n += 1, s.sum += v, s.max = std::max(s.max, v);
@@ -51,16 +52,16 @@ LabelErrorSummary LabelErrors::summary(const std::vector<std::int8_t>& status) c
 }
 
 LabelErrorSummary& LabelErrorSummary::operator+=(const LabelErrorSummary& o) {
-  n += o.n, missing += o.missing, above_1_percent += o.above_1_percent, above_5_percent += o.above_5_percent;
+  n += o.n, missing += o.missing, inverted += o.inverted, above_1_percent += o.above_1_percent, above_5_percent += o.above_5_percent;
   sum += o.sum, max = std::max(max, o.max);
   return *this;
 }
 
 void LabelErrorSummary::sum_over(MPI_Comm comm, bool contribute) {
-  std::int64_t c[4] = {n, missing, above_1_percent, above_5_percent}, ct[4];
+  std::int64_t c[5] = {n, missing, inverted, above_1_percent, above_5_percent}, ct[5];
   for (auto& x : c) x = contribute ? x : 0;
-  MPI_Allreduce(c, ct, 4, MPI_INT64_T, MPI_SUM, comm);
-  n = ct[0], missing = ct[1], above_1_percent = ct[2], above_5_percent = ct[3];
+  MPI_Allreduce(c, ct, 5, MPI_INT64_T, MPI_SUM, comm);
+  n = ct[0], missing = ct[1], inverted = ct[2], above_1_percent = ct[3], above_5_percent = ct[4];
   double x[2] = {contribute ? sum : 0.0, contribute ? max : 0.0}, t[2];
   MPI_Allreduce(&x[0], &t[0], 1, MPI_DOUBLE, MPI_SUM, comm);
   MPI_Allreduce(&x[1], &t[1], 1, MPI_DOUBLE, MPI_MAX, comm);
@@ -70,14 +71,16 @@ void LabelErrorSummary::sum_over(MPI_Comm comm, bool contribute) {
 nlohmann::json LabelErrorSummary::json() const {
   return {{"load_cases", n},           {"mean_rel_l2", n ? sum / double(n) : 0.0},
           {"max_rel_l2", max},         {"above_1_percent", above_1_percent},
-          {"above_5_percent", above_5_percent}, {"without_estimate", missing}};
+          {"above_5_percent", above_5_percent}, {"without_estimate", missing},
+          {"inverted_in_a_cell", inverted}};
 }
 
 std::string LabelErrorSummary::line() const {
   if (n == 0 && missing == 0) return "";
   return fmt::format("  label error estimate (relative L2 of u): mean {:.3g}, max {:.3g}; above 1%: {} of {}, "
-                     "above 5%: {}; {} converged load cases without an estimate\n",
-                     n ? sum / double(n) : 0.0, max, above_1_percent, n, above_5_percent, missing);
+                     "above 5%: {}; {} converged load cases without an estimate{}\n",
+                     n ? sum / double(n) : 0.0, max, above_1_percent, n, above_5_percent, missing,
+                     inverted ? fmt::format(" ({} of them: the label inverts inside a cell)", inverted) : "");
 }
 
 void LabelErrors::estimate(MPI_Comm group, const config::DatasetConfig& cfg, const ShapeSample& shape,
@@ -89,6 +92,7 @@ void LabelErrors::estimate(MPI_Comm group, const config::DatasetConfig& cfg, con
     if (!estimator_) estimator_ = std::make_unique<LabelErrorEstimator>(group, cfg, shape, first, coarse);
     rel_l2_[L] = max_u_[L] = alpha_[L] = -1;  // no estimate (until it is formed)
     const solver::ErrorEstimate e = estimator_->estimate(cfg, lc, u, alpha, coarse_solve);
+    if (e.inverted) rel_l2_[L] = max_u_[L] = alpha_[L] = inverted_label;
     if (!e.ok) return;
     rel_l2_[L] = e.rel_l2;
     max_u_[L] = e.max_u;

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <limits>
 #include <map>
@@ -61,9 +62,11 @@ Discretisation parse_discretisation(const std::string& spec) {
         throw std::invalid_argument("discretisation '" + spec + "': dilatation must be pointwise or mean, not '" +
                                     value + "'");
       d.dilatation = value;
+    } else if (key == "share") {
+      d.pointwise_share = number();
     } else
       throw std::invalid_argument("discretisation '" + spec + "': unknown key '" + key +
-                                  "' (allowed: h, surface_h, interior_h, rim, load, grading, label_on, dilatation=pointwise|mean)");
+                                  "' (allowed: h, surface_h, interior_h, rim, load, grading, label_on, dilatation=pointwise|mean, share)");
   }
   if (!(d.surface_h > 0 && d.interior_h > 0 && d.grading > 0))
     throw std::invalid_argument("discretisation '" + spec + "': h, surface_h, interior_h, grading must be > 0");
@@ -81,6 +84,8 @@ struct Scene {
   factory::LoadCase lc;
 };
 
+double norm3(const std::array<double, 3>& a, const std::array<double, 3>& b);
+
 Scene make_scene(const std::string& name) {
   Scene s;
   s.cfg = config::parse_dataset_text("preset: random3d\n", "<study_labels3d>");
@@ -92,14 +97,33 @@ Scene make_scene(const std::string& name) {
     s.lc.direction = {0, 1, 0};
     return s;
   }
-  if (name != "r3d-0") throw std::invalid_argument("scene '" + name + "' (allowed: ball, r3d-0)");
-  factory::ShapeConfig c = factory::shape_config(s.cfg, 0);
-  c.mesh_h = c.h;  // the surface as drawn
-  c.surface_h = 0, c.rim_size = 0;  // no remeshing: the preset's own (rim) would redraw shape 0
-  const factory::ShapeSample shape = factory::make_shape(c, std::nullopt, s.cfg.seed, 0);
-  s.surface = shape.boundary;
-  s.p_d = shape.dirichlet_center;
-  s.lc = factory::draw_load_cases(shape, s.cfg.loads, s.cfg.seed, factory::n_tractions(s.cfg)).at(0);
+  if (name == "r3d-0") {
+    factory::ShapeConfig c = factory::shape_config(s.cfg, 0);
+    c.mesh_h = c.h;  // the surface as drawn
+    c.surface_h = 0, c.rim_size = 0;  // no remeshing: the preset's own (rim) would redraw shape 0
+    const factory::ShapeSample shape = factory::make_shape(c, std::nullopt, s.cfg.seed, 0);
+    s.surface = shape.boundary;
+    s.p_d = shape.dirichlet_center;
+    s.lc = factory::draw_load_cases(shape, s.cfg.loads, s.cfg.seed, factory::n_tractions(s.cfg)).at(0);
+    return s;
+  }
+  unsigned long long seed = 0;
+  int shape_id = -1, load_id = -1;
+  if (std::sscanf(name.c_str(), "r3d:%llu:%d:%d", &seed, &shape_id, &load_id) != 3 || shape_id < 0 || load_id < 0 ||
+      load_id >= s.cfg.loads.count)
+    throw std::invalid_argument("scene '" + name + "' (allowed: ball, r3d-0, r3d:SEED:SHAPE:LOAD)");
+  // A load case of the random3d preset's factory at another seed: the shape and the load case as
+  // the factory draws them (p_N on the preset's remeshed surface), solved on the shape as drawn.
+  s.cfg.seed = seed;
+  const factory::ShapeSample as_solved = factory::make_shape(factory::shape_config(s.cfg, shape_id), std::nullopt, seed, shape_id);
+  factory::ShapeConfig c = factory::shape_config(s.cfg, shape_id);
+  c.mesh_h = c.h, c.surface_h = 0, c.rim_size = 0;
+  const factory::ShapeSample drawn = factory::make_shape(c, std::nullopt, seed, shape_id);
+  if (norm3(drawn.dirichlet_center, as_solved.dirichlet_center) > 1e-12)
+    throw std::invalid_argument("scene '" + name + "': the preset's remeshing redrew this shape (another draw)");
+  s.surface = drawn.boundary;
+  s.p_d = drawn.dirichlet_center;
+  s.lc = factory::draw_load_cases(as_solved, s.cfg.loads, seed, factory::n_tractions(s.cfg)).at(std::size_t(load_id));
   return s;
 }
 
@@ -170,7 +194,10 @@ Solved solve(const Scene& s, const Discretisation& d, double alpha, std::optiona
   physics::SpaceOptions so;
   so.degree = 2;
   config::DatasetConfig cfg = s.cfg;
-  for (auto i : cfg.scene.find("neo_hookean")) cfg.scene.effects[i].params["dilatation"] = std::string(d.dilatation);
+  for (auto i : cfg.scene.find("neo_hookean")) {
+    cfg.scene.effects[i].params["dilatation"] = std::string(d.dilatation);
+    if (d.pointwise_share > 0) cfg.scene.effects[i].params["pointwise_share"] = d.pointwise_share;
+  }
   auto sp = factory::make_shape_problem(PETSC_COMM_SELF, cfg, o.shape, s.lc, so);
   const physics::Problem& problem = *sp.problem;
   set_linear_solver(true);

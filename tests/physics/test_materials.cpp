@@ -349,6 +349,10 @@ TEST_CASE("Catalogue materials reject bad parameters naming the key", "[material
       {"neo_hookean", core::MapParams({{"E", 1.0}, {"nu", 0.3}, {"E_cv", -0.5}, {"E_length", 0.1}}), "E_cv"},
       {"linear_elastic", core::MapParams({{"E", 1.0}, {"nu", 0.3}, {"E_length", 0.1}}), "E_length"},
       {"neo_hookean", core::MapParams({{"E", 1.0}, {"nu", 0.3}, {"dilatation", std::string("average")}}), "dilatation"},
+      {"neo_hookean", core::MapParams({{"E", 1.0}, {"nu", 0.3}, {"pointwise_share", 0.1}}), "pointwise_share"},
+      {"neo_hookean",
+       core::MapParams({{"E", 1.0}, {"nu", 0.3}, {"dilatation", std::string("mean")}, {"pointwise_share", 1.0}}),
+       "pointwise_share"},
   };
   for (const Bad& b : cases) {
     INFO(b.effect << ": expecting a message naming " << b.key);
@@ -411,4 +415,33 @@ TEST_CASE("Mean dilatation: energy, residual and tangent consistent; the pointwi
         if (degree == 2) CHECK(hstest::rel_diff(residual(*mean, u), residual(*pointwise, u)) > 1e-4);
       }
     }
+}
+
+TEST_CASE("Mean dilatation with a pointwise share: the blend of the two materials, consistent",
+          "[assembly][materials][mean_dilatation]") {
+  // b lambda on the pointwise dilatation, (1 - b) lambda on the cell means: energy and residual
+  // are exactly (1 - b) (mean) + b (pointwise), the shear part being common to both.
+  const double nu = 0.49, b = 0.3;
+  auto blend = disk_problem(make_neo_hookean_mean_dilatation(E, nu, {}, b), 2);
+  auto mean = disk_problem(make_neo_hookean_mean_dilatation(E, nu), 2);
+  auto pointwise = disk_problem(make_neo_hookean(E, nu), 2);
+  core::VecH u = blend->create_vector(), v = blend->create_vector();
+  hstest::interpolate(*blend, [](const double* x, double* f) { smooth_field(x, f, 0.5); }, u);
+  hstest::interpolate(*blend, [](const double* x, double* f) {
+    f[0] = 0.1 * x[1] * x[1] + 0.05;
+    f[1] = -0.2 * x[0] * x[1];
+  }, v);
+  check_consistency(*blend, u, v);
+  double e_blend = 0, e_mean = 0, e_pw = 0;
+  REQUIRE(blend->energy(u, 0.0, e_blend));
+  REQUIRE(mean->energy(u, 0.0, e_mean));
+  REQUIRE(pointwise->energy(u, 0.0, e_pw));
+  CHECK(e_blend == Approx((1 - b) * e_mean + b * e_pw).epsilon(1e-12));
+  core::VecH r = blend->create_vector(), rm = blend->create_vector(), rp = blend->create_vector();
+  REQUIRE(blend->residual(u, 0.0, r));
+  REQUIRE(mean->residual(u, 0.0, rm));
+  REQUIRE(pointwise->residual(u, 0.0, rp));
+  HS_PETSC(VecAXPBY(rm, b, 1 - b, rp));  // rm = (1 - b) rm + b rp
+  CHECK(hstest::rel_diff(r, rm) < 1e-12);
+  CHECK(hstest::rel_diff(r, rp) > 1e-4);  // and it is neither of them
 }

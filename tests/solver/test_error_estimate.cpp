@@ -5,7 +5,8 @@
 ///    uniform dead traction) has a zero estimate (round-off);
 ///  - on the manufactured finite-strain solution of test_mms (smooth: the error falls like
 ///    h^(p+1), so -error_estimate_order p+1) the estimate falls at that rate and stays within
-///    [0.5, 2] of the true error.
+///    [0.5, 2] of the true error;
+///  - a field with det F <= 0 between the coarse quadrature points is flagged (inverted).
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdio>
@@ -224,4 +225,47 @@ TEST_CASE("The estimate on the solver's factor is the estimate on its own", "[er
   const solver::ErrorEstimate none =
       p.est->estimate(ns.solution(), t.alpha, [&](Vec b, Vec z) { return fresh.apply_tangent_factor(b, z); });
   CHECK_FALSE(none.ok);
+}
+
+TEST_CASE("A label that inverts inside a cell is flagged, not estimated", "[error_estimate]") {
+  // u = (phi(x), 0) with phi' = x - x0 - 1: det F = x - x0, exactly linear in x (phi is in P2).
+  // x0 below every quadrature point of the coarse cells but above the refined mesh's nearest
+  // ones: the coarse problem accepts u (det F > 0 where it looks), the refined mesh sees it
+  // inverted next to x = 0 -- what a mean-dilatation label does under a traction narrower than
+  // its cells (docs/ACCURACY.md, "Labels that invert inside a cell").
+  auto effects = [] {
+    std::vector<physics::EffectPtr> e;
+    e.push_back(physics::make_neo_hookean(500, 0.3));
+    e.push_back(physics::make_dirichlet("roller_y", hstest::on_plane(1, 0.0), {1}));
+    return e;
+  };
+  Pair p = make_pair(mesh::mesh_box(2, 1.0, 0.5), 2, effects);
+  auto min_qp_x = [](const physics::Problem& pr) {
+    const auto& s = pr.space();
+    double m = INFINITY;
+    for (PetscInt c = s.cell_begin(); c < s.cell_end(); ++c)
+      for (int q = 0; q < s.n_qp(); ++q) {
+        double x[3] = {0, 0, 0};
+        s.map_point(c, q, x);
+        m = std::min(m, x[0]);
+      }
+    double g = m;
+    MPI_Allreduce(&m, &g, 1, MPI_DOUBLE, MPI_MIN, PETSC_COMM_WORLD);
+    return g;
+  };
+  const double xc = min_qp_x(*p.coarse), xf = min_qp_x(*p.fine);
+  REQUIRE(xf < 0.75 * xc);
+  for (const double x0 : {0.75 * xc, -0.1}) {  // inverted next to x = 0; nowhere
+    DYNAMIC_SECTION("x0 " << x0) {
+      core::VecH u = p.coarse->create_vector();
+      hstest::interpolate(*p.coarse, [x0](const double* x, double* v) {
+        v[0] = 0.5 * (x[0] - x0) * (x[0] - x0) - x[0] - 0.5 * x0 * x0;
+        v[1] = 0;
+      }, u);
+      REQUIRE(p.coarse->min_det_f(u) > 0);
+      const solver::ErrorEstimate e = p.est->estimate(u, 0.0);
+      CHECK(e.inverted == (x0 > 0));
+      if (x0 > 0) CHECK_FALSE(e.ok);
+    }
+  }
 }

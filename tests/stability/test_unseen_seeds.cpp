@@ -19,6 +19,8 @@
 #include "hypershape/factory/load_cases.hpp"
 #include "hypershape/factory/shape_pipeline.hpp"
 #include "hypershape/solver/nonlinear.hpp"
+#include "hypershape/solver/error_estimate.hpp"
+#include "hypershape/mesh/refine.hpp"
 #include "support/stable_state.hpp"
 
 using namespace hypershape;
@@ -40,7 +42,9 @@ struct Case {
 
   Case(std::uint64_t seed, int shape_id, const std::string& config = HS_SOURCE_DIR "/configs/presets/random2d.yaml")
       : cfg(config::parse_dataset_file(config)) {
-    cfg.loads.count = 50;  // the targets are stratified over the load count: keep the preset's
+    // The targets are stratified over the load count: 50 as scripts/bench_stability.sh runs the
+    // preset, or LOADS (a dataset config's own count, to replay its load cases).
+    cfg.loads.count = env_int("LOADS", 50);
     cfg.seed = seed;
     shape = factory::make_shape(factory::shape_config(cfg, shape_id), std::nullopt, cfg.seed, shape_id);
     loads = factory::draw_load_cases(shape, cfg.loads, cfg.seed, factory::n_tractions(cfg));
@@ -92,6 +96,7 @@ TEST_CASE("Unseen-seed load cases that need a branch switch end stable on target
 /// dataset config (with 50 load cases per shape, as scripts/bench_stability.sh runs it):
 ///   SEED=777 SHAPE=3 LOAD=47 PETSC_OPTIONS="-info :snes" unit_tests "[unseen_replay]"
 ///   CONFIG=configs/examples/multi_load2d.yaml SEED=17 SHAPE=19 LOAD=3 unit_tests "[unseen_replay]"
+///   CONFIG=random3d_10x20.yaml LOADS=20 SEED=90210 SHAPE=0 LOAD=0 unit_tests "[unseen_replay]"
 TEST_CASE("Replay one shape's load cases as the factory does", "[.][unseen_replay]") {
   const char* config = std::getenv("CONFIG");
   Case c(std::uint64_t(env_int("SEED", 777)), env_int("SHAPE", 3),
@@ -170,5 +175,33 @@ TEST_CASE("Under fixed gravity the path starts from the gravity state and keeps 
     INFO("shape " << shape_id << " load " << load_id << ": " << r.reason << " (" << r.newton_iterations << " its)");
     CHECK(r.alpha > 0);
     hstest::check_stable_on_target(*c.sp.problem, ns.solution(), r, lc.target, c.cfg.solver);
+  }
+}
+
+/// Solves a shape's load cases in order (as the replay above) and prints, per load case, min det F of
+/// the label at its own quadrature points (loads/min_det_f) and at those of the uniformly refined
+/// mesh (the same field sampled between them: <= 0 where it inverts inside a cell; the error
+/// estimate stores -2 there). docs/ACCURACY.md, "Labels that invert inside a cell":
+///   CONFIG=r3d.yaml LOADS=8 SEED=90210 SHAPE=0 unit_tests "[inversion_replay]"
+TEST_CASE("Replay a shape's load cases: min det F between the quadrature points", "[.][inversion_replay]") {
+  const char* config = std::getenv("CONFIG");
+  Case c(std::uint64_t(env_int("SEED", 777)), env_int("SHAPE", 3), config ? config : HS_SOURCE_DIR "/configs/presets/random2d.yaml");
+  solver::NonlinearSolver ns(*c.sp.problem, c.cfg.solver);
+  const mesh::RefinedMesh refined = mesh::refine_uniform(c.shape.mesh);
+  factory::ShapeSample fs;
+  fs.shape_id = c.shape.shape_id;
+  fs.dirichlet_center = c.shape.dirichlet_center;
+  fs.dirichlet_radius = c.shape.dirichlet_radius;
+  fs.mesh = refined.mesh;
+  auto fine = factory::make_shape_problem(PETSC_COMM_WORLD, c.cfg, fs, c.loads[0], physics::SpaceOptions{c.sp.problem->space().degree()});
+  solver::TwoLevelEstimator est(*c.sp.problem, *fine.problem, refined);
+  core::VecH pu = fine.problem->create_vector();
+  for (int l = 0; l < int(c.loads.size()); ++l) {
+    const auto& lc = c.set(l);
+    ns.reset();
+    const auto r = ns.solve_for_target(lc.target);
+    est.prolong(ns.solution(), pu);
+    std::cout << "load " << l << " target " << lc.target << " conv " << r.converged << " alpha " << r.alpha << " its " << r.newton_iterations
+              << " min detF coarse " << c.sp.problem->min_det_f(ns.solution()) << " fine " << fine.problem->min_det_f(pu) << std::endl;
   }
 }

@@ -44,7 +44,8 @@ class LabelErrorEstimator {
 /// The labels' estimated errors (loads/error_estimate_rel_l2) over converged load cases: a
 /// shape's, a task's run report's; += to sum, sum_over to reduce over the group roots.
 struct LabelErrorSummary {
-  std::int64_t n = 0, missing = 0, above_1_percent = 0, above_5_percent = 0;  ///< missing: -1 stored
+  std::int64_t n = 0, missing = 0, above_1_percent = 0, above_5_percent = 0;  ///< missing: -1 or -2 stored
+  std::int64_t inverted = 0;  ///< of the missing: -2, the label inverts inside a cell
   double sum = 0, max = 0;
   LabelErrorSummary& operator+=(const LabelErrorSummary& o);
   /// Summed (max: maximum) over `comm`, counting only the ranks where `contribute`. Collective.
@@ -56,11 +57,14 @@ struct LabelErrorSummary {
 /// The per-load-case estimates of one shape, as the shape job stores them
 /// (loads/error_estimate_rel_l2, _max_u, _alpha; 0 for a load case that failed, -1 in all
 /// three for a converged one whose estimate could not be formed: the fine Newton step found
-/// no descent, e.g. a state the refined mesh does not hold stable). The estimator is built at
+/// no descent, e.g. a state the refined mesh does not hold stable; -2 (inverted_label) where the
+/// label's own field has det F <= 0 inside a cell, at the refined mesh's quadrature points).
+/// The estimator is built at
 /// the first converged load case.
 /// On when the dataset asks for it (representations.error_estimate).
 class LabelErrors {
  public:
+  static constexpr double inverted_label = -2;  ///< stored where the label inverts inside a cell
   LabelErrors(const config::DatasetConfig& cfg, int n_loads);
   /// Estimates load case `lc` (converged: u at alpha, `coarse_solve` the solver's factor).
   /// Collective over `group`; a failure leaves -1 (a PETSc error is logged), never thrown.

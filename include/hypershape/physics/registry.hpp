@@ -21,7 +21,8 @@ void register_spring();
 /// Materials; `field` (optional) is a modulus factor m(x) > 0: W(x, F) = m(x) W(F).
 EffectPtr make_neo_hookean(double E, double nu, ScalarFunction field = {});
 /// The same material with its volumetric energy on each cell's mean dilatation (dilatation: mean).
-EffectPtr make_neo_hookean_mean_dilatation(double E, double nu, ScalarFunction field = {});
+/// pointwise_share in [0, 1): the share of the bulk modulus kept on the pointwise dilatation.
+EffectPtr make_neo_hookean_mean_dilatation(double E, double nu, ScalarFunction field = {}, double pointwise_share = 0);
 EffectPtr make_saint_venant_kirchhoff(double E, double nu, ScalarFunction field = {});
 /// C1, C2 >= 0 with C1 + C2 > 0, kappa > 0 (see mooney_rivlin.hpp).
 EffectPtr make_mooney_rivlin(double C1, double C2, double kappa, ScalarFunction field = {});

@@ -32,6 +32,10 @@ namespace hypershape::solver {
 
 struct ErrorEstimate {
   bool ok = false;           ///< false: the estimate could not be formed (values 0)
+  /// Not formed because u_h itself has det F <= 0 at a quadrature point of the refined mesh: the
+  /// label's field inverts inside a cell, between the points its own solve checked (seen with
+  /// the mean-dilatation element under tractions narrower than a cell; docs/ACCURACY.md).
+  bool inverted = false;
   double rel_l2 = 0;         ///< relative L2 error of u (function norm)
   double max_u = 0;          ///< relative error of max|u|, signed
   double alpha = 0;          ///< relative error of alpha for the stored target, signed

@@ -29,10 +29,11 @@ struct Discretisation {
   /// The material's volumetric energy: "pointwise" (the seed's) or "mean" (neo_hookean's
   /// dilatation: mean, the P2/P0 mean-dilatation element).
   std::string dilatation = "pointwise";
+  double pointwise_share = 0;  ///< with mean: neo_hookean's pointwise_share
   bool per_load() const { return load_size > 0; }
 };
 
-/// Parses "name:key=value,key=value" (keys surface_h, interior_h, h (both), rim, load,
+/// Parses "name:key=value,key=value" (keys surface_h, interior_h, h (both), rim, load, share,
 /// grading, label_on, dilatation). Throws std::invalid_argument naming the bad key.
 Discretisation parse_discretisation(const std::string& spec);
 

@@ -11,6 +11,12 @@
 ///   U(theta) = lambda/2 ln^2 theta,  U' = lambda ln theta / theta,  U'' = lambda (1 - ln theta) / theta^2,
 /// the cell's residual is U' g and its tangent U''/V_e g g^T + U' H (+ the mu part's, pointwise).
 /// A modulus field m(x) scales mu pointwise and lambda by its cell mean.
+///
+/// pointwise_share b (key `pointwise_share`, default 0) puts the share b of lambda back on the
+/// pointwise dilatation: V_e (1 - b) lambda/2 (ln theta_e)^2 + int_e b lambda/2 (ln J)^2 dX. With
+/// b = 0, a traction narrower than a cell (gamma 0.1 on the random3d preset's 0.25 cells)
+/// crushes the part of the cell under it -- only the cell's mean volume is held -- and the label
+/// inverts between the quadrature points (docs/ACCURACY.md, "Labels that invert inside a cell").
 #include <cmath>
 #include <stdexcept>
 
@@ -24,8 +30,9 @@ namespace {
 
 class MeanDilatationNeoHookean : public Effect {
  public:
-  MeanDilatationNeoHookean(double mu, double lambda, ScalarFunction field)
-      : shear_("neo_hookean", NeoHookean<2>{mu, 0.0}, NeoHookean<3>{mu, 0.0}, field),
+  /// lambda: the bulk modulus on the cell means; lambda_pointwise: the one at every point.
+  MeanDilatationNeoHookean(double mu, double lambda, ScalarFunction field, double lambda_pointwise)
+      : shear_("neo_hookean", NeoHookean<2>{mu, lambda_pointwise}, NeoHookean<3>{mu, lambda_pointwise}, field),
         lambda_(lambda),
         field_(std::move(field)) {}
 
@@ -149,9 +156,10 @@ class MeanDilatationNeoHookean : public Effect {
 
 }  // namespace
 
-EffectPtr make_neo_hookean_mean_dilatation(double E, double nu, ScalarFunction field) {
+EffectPtr make_neo_hookean_mean_dilatation(double E, double nu, ScalarFunction field, double pointwise_share) {
   const Lame l = Lame::from_young_poisson(E, nu);
-  return std::make_unique<MeanDilatationNeoHookean>(l.mu, l.lambda, std::move(field));
+  return std::make_unique<MeanDilatationNeoHookean>(l.mu, (1 - pointwise_share) * l.lambda, std::move(field),
+                                                    pointwise_share * l.lambda);
 }
 
 }  // namespace hypershape::physics
