@@ -443,7 +443,10 @@ bool TwoLevelEstimator::fine_newton(Vec Pu, double alpha, Vec e, ErrorEstimate& 
     // the better-converged steps of the SOR smoother, two first load cases of 18 (Random2D
     // shapes 2 and 5) found none at their second step, round-off near the minimum.
     if (!accepted && it > 0) break;
-    if (!accepted) return false;
+    if (!accepted) {
+      HS_PETSC(PetscInfo(ksp_.get(), "error estimate: no energy descent along the fine Newton step nor the preconditioner's\n"));
+      return false;
+    }
     if (full_step) {  // done: one full step is the estimate (no residual needed after it)
       HS_PETSC(VecSwap(x, w));
       break;
@@ -529,6 +532,7 @@ ErrorEstimate TwoLevelEstimator::estimate(Vec u_h, double alpha, const CoarseSol
   bool ok = prepare_coarse(u_h, coarse_solve, out) && fine_newton(Pu, alpha, e, out);
   // du/dalpha = K_c^-1 f_ext on the coarse level's factor (a back-solve).
   if (ok) coarse_apply(coarse_.load(), a);
+  if (coarse_failed_) HS_PETSC(PetscInfo(ksp_.get(), "error estimate: the coarse solve failed\n"));
   ok = ok && !coarse_failed_;
   coarse_solve_ = nullptr;
   const std::vector<double> uc = coarse_.gather(u_h).values, ev = fine_.gather(e).values, av = coarse_.gather(a).values;
