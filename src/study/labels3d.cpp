@@ -86,6 +86,28 @@ struct Scene {
 
 double norm3(const std::array<double, 3>& a, const std::array<double, 3>& b);
 
+/// Scene "r3d:SEED:SHAPE:LOAD": a load case of the random3d preset's factory at another seed; the
+/// shape and the load case as the factory draws them (p_N on the preset's remeshed surface),
+/// solved on the shape as drawn.
+Scene factory_load_case(Scene s, const std::string& name) {
+  unsigned long long seed = 0;
+  int shape_id = -1, load_id = -1;
+  if (std::sscanf(name.c_str(), "r3d:%llu:%d:%d", &seed, &shape_id, &load_id) != 3 || shape_id < 0 || load_id < 0 ||
+      load_id >= s.cfg.loads.count)
+    throw std::invalid_argument("scene '" + name + "' (allowed: ball, r3d-0, r3d:SEED:SHAPE:LOAD)");
+  s.cfg.seed = seed;
+  const factory::ShapeSample as_solved = factory::make_shape(factory::shape_config(s.cfg, shape_id), std::nullopt, seed, shape_id);
+  factory::ShapeConfig c = factory::shape_config(s.cfg, shape_id);
+  c.mesh_h = c.h, c.surface_h = 0, c.rim_size = 0;
+  const factory::ShapeSample drawn = factory::make_shape(c, std::nullopt, seed, shape_id);
+  if (norm3(drawn.dirichlet_center, as_solved.dirichlet_center) > 1e-12)
+    throw std::invalid_argument("scene '" + name + "': the preset's remeshing redrew this shape (another draw)");
+  s.surface = drawn.boundary;
+  s.p_d = drawn.dirichlet_center;
+  s.lc = factory::draw_load_cases(as_solved, s.cfg.loads, seed, factory::n_tractions(s.cfg)).at(std::size_t(load_id));
+  return s;
+}
+
 Scene make_scene(const std::string& name) {
   Scene s;
   s.cfg = config::parse_dataset_text("preset: random3d\n", "<study_labels3d>");
@@ -107,24 +129,7 @@ Scene make_scene(const std::string& name) {
     s.lc = factory::draw_load_cases(shape, s.cfg.loads, s.cfg.seed, factory::n_tractions(s.cfg)).at(0);
     return s;
   }
-  unsigned long long seed = 0;
-  int shape_id = -1, load_id = -1;
-  if (std::sscanf(name.c_str(), "r3d:%llu:%d:%d", &seed, &shape_id, &load_id) != 3 || shape_id < 0 || load_id < 0 ||
-      load_id >= s.cfg.loads.count)
-    throw std::invalid_argument("scene '" + name + "' (allowed: ball, r3d-0, r3d:SEED:SHAPE:LOAD)");
-  // A load case of the random3d preset's factory at another seed: the shape and the load case as
-  // the factory draws them (p_N on the preset's remeshed surface), solved on the shape as drawn.
-  s.cfg.seed = seed;
-  const factory::ShapeSample as_solved = factory::make_shape(factory::shape_config(s.cfg, shape_id), std::nullopt, seed, shape_id);
-  factory::ShapeConfig c = factory::shape_config(s.cfg, shape_id);
-  c.mesh_h = c.h, c.surface_h = 0, c.rim_size = 0;
-  const factory::ShapeSample drawn = factory::make_shape(c, std::nullopt, seed, shape_id);
-  if (norm3(drawn.dirichlet_center, as_solved.dirichlet_center) > 1e-12)
-    throw std::invalid_argument("scene '" + name + "': the preset's remeshing redrew this shape (another draw)");
-  s.surface = drawn.boundary;
-  s.p_d = drawn.dirichlet_center;
-  s.lc = factory::draw_load_cases(as_solved, s.cfg.loads, seed, factory::n_tractions(s.cfg)).at(std::size_t(load_id));
-  return s;
+  return factory_load_case(std::move(s), name);
 }
 
 double norm3(const std::array<double, 3>& a, const std::array<double, 3>& b) {

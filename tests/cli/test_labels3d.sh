@@ -5,7 +5,8 @@
 # uniformly finer solve (P2 h 0.2) to within the two labels' stated errors against the ball's
 # reference (docs/ACCURACY.md, "3D labels");
 # the label is on the stored mesh's vertices; the per-load mesh raises max|u| at the load above
-# the coarse one's. Bad discretisation keys name the allowed ones. A sphere scene accepts the
+# the coarse one's. Bad discretisation keys and scenes name the allowed ones; a factory load case
+# (r3d:SEED:SHAPE:LOAD) is a scene, and share= (pointwise_share) lies between its two materials. A sphere scene accepts the
 # datasets' mesh.surface_h / mesh.rim (hypershape solve). ~40 s on a quiet machine (slow).
 set -u
 bin_dir=$(dirname "${HYPERSHAPE_BIN:?}")
@@ -18,6 +19,24 @@ export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
 msg=$("$study" --scene ball --reference a -d a:h=0.3,bogus=1 --out "$work/x.json" 2>&1); code=$?
 [ "$code" -ne 0 ] && grep -q "unknown key 'bogus'" <<<"$msg" && grep -q "allowed: h, surface_h" <<<"$msg" ||
   { echo "FAIL: bad key: exit $code, $msg"; exit 1; }
+
+msg=$("$study" --scene r3d:1:2 --reference a -d a:h=0.3 --out "$work/x.json" 2>&1); code=$?
+[ "$code" -ne 0 ] && grep -q "allowed: ball, r3d-0, r3d:SEED:SHAPE:LOAD" <<<"$msg" && [ ! -e "$work/x.json" ] ||
+  { echo "FAIL: bad scene: exit $code, $msg"; exit 1; }
+echo "ok   a bad scene names the allowed ones"
+
+# A factory load case as a scene (r3d:SEED:SHAPE:LOAD) and neo_hookean's pointwise_share (share=):
+# half the bulk energy pointwise gives a label between the mean-dilatation and pointwise ones.
+"$study" --scene r3d:90210:0:1 --reference m -d m:h=0.3,dilatation=mean -d s:h=0.3,dilatation=mean,share=0.5 \
+  -d p:h=0.3 --out "$work/f.json" 2> "$work/f.txt" || { echo "FAIL: study_labels3d r3d:90210:0:1"; cat "$work/f.txt"; exit 1; }
+/usr/bin/python3 - "$work/f.json" <<'PY' || exit 1
+import json, sys
+d = json.load(open(sys.argv[1]))
+r = {x["name"]: x["error"]["label_max_u"] for x in d["results"]}
+ok = r["p"] < r["s"] < r["m"]
+print(("ok   " if ok else "FAIL ") + f"r3d:90210:0:1: max|u| pointwise {r['p']:.4f} < share 0.5 {r['s']:.4f} < mean {r['m']:.4f}")
+sys.exit(0 if ok else 1)
+PY
 
 # A scene accepts the datasets' 3D discretisation keys (mesh.surface_h, mesh.rim): the ball is
 # then meshed as the factory meshes a shape, refined at the rim; a 2D scene rejects them by name.
