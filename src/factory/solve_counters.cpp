@@ -6,13 +6,13 @@ namespace hypershape::factory {
 
 namespace {
 
-constexpr std::size_t kCounters = 10;
+constexpr std::size_t kCounters = 11;
 
 /// The counters in one fixed order (C: SolveCounters or const SolveCounters).
 template <class C>
 auto fields(C& c) {
   return std::array{&c.loads_ok, &c.loads_failed, &c.newton_iterations, &c.solves, &c.failed_increments,
-          &c.recovery_iterations, &c.linear.numeric_factorizations, &c.linear.symbolic_factorizations,
+          &c.off_path_increments, &c.recovery_iterations, &c.linear.numeric_factorizations, &c.linear.symbolic_factorizations,
           &c.linear.krylov_iterations, &c.linear.tangent_assemblies};
 }
 
@@ -22,6 +22,7 @@ void SolveCounters::add(const solver::TargetResult& r) {
   newton_iterations += r.newton_iterations;
   solves += r.solves;
   failed_increments += r.failed_increments;
+  off_path_increments += r.off_path_increments;
   recovery_iterations += r.recovery_iterations;
   linear += r.linear;
 }
@@ -46,6 +47,7 @@ nlohmann::json SolveCounters::solver_json() const {
   return {{"newton_iterations", newton_iterations},
           {"nonlinear_solves", solves},
           {"failed_increments", failed_increments},
+          {"off_path_increments", off_path_increments},
           {"recovery_iterations", recovery_iterations},
           {"numeric_factorizations", linear.numeric_factorizations},
           {"symbolic_factorizations", linear.symbolic_factorizations},

@@ -197,6 +197,7 @@ void NonlinearSolver::switch_branch(double target, double start, int attempt, Ta
   p.solves += t.solves;
   p.newton_iterations += t.newton_iterations;
   p.failed_increments += t.failed_increments;
+  p.off_path_increments += t.off_path_increments;
   p.increments += t.increments;
   p.recovery_iterations += t.recovery_iterations;
   p.reason = p.converged ? "target reached after a branch switch (" + before + ")"

@@ -193,6 +193,7 @@ TargetResult NonlinearSolver::solve_for_target(double target) {
     t.solves += path.solves;
     t.newton_iterations += path.newton_iterations;
     t.failed_increments += path.failed_increments;
+    t.off_path_increments += path.off_path_increments;
     t.increments += path.increments;
     t.recovery_iterations += path.newton_iterations;
     t.reason = (t.converged ? "target reached by load control" : t.reason) +

@@ -221,11 +221,39 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
       why = "line search found no admissible decrease";
       return false;
     }
+    if (off_the_path(rtol, lambda)) {
+      left_path_ = true;
+      why = "indefinite tangent off the path (a damped step with " + std::to_string(negative_pivots_) +
+            " negative pivot(s))";
+      return false;
+    }
     HS_PETSC(VecCopy(w_, u_));
     s_ += lambda * dalpha;
     HS_PETSC(VecWAXPY(r_, (1.0 - lambda) * dalpha, problem_.load_at(u_), b_));  // R(w, s_)
     HS_PETSC(VecNorm(r_, NORM_2, &rn));
   }
+}
+
+bool NonlinearSolver::off_the_path(double rtol, double lambda) const {
+  // An intermediate iterate whose tangent has more negative eigenvalues than the state the
+  // increment started from, and whose Newton step the line search cut below 0.3: the predictor
+  // overshot into a region where the energy is not convex, away from the path's equilibria (on
+  // the path, even on an unstable segment past a limit point, Newton near an equilibrium takes
+  // whole steps). Newton there creeps with cut steps and mostly fails after 4-12 iterations
+  // (P2 paths on Random2D: a quarter of their Newton iterations were in such increments);
+  // failing at once and halving the increment costs one. Only on an increment's first try (the
+  // increment before it did not fail): where the path itself turns indefinite (a bifurcation
+  // ahead), its retries creep on as before rather than shrink to nothing. Not on the last
+  // increment: its state on target is reached and classified (stable, or a fold).
+  // Measured side by side with the default (README, "How it solves"): Random2D P2 h 0.12, 8
+  // shapes x 25 load cases on the unseen seeds 2024 and 777: Newton iterations per load case
+  // 21.1 / 20.6 -> 19.0 / 19.0, the same 199 / 200 converged; Random2D P1 h 0.04, 1000 load
+  // cases on each of the seeds 777, 2024, 31337: 14.9 / 11.7 / 13.7 -> 14.3 / 11.2 / 13.2, p99
+  // 98 / 51 / 79 -> 99 / 42 / 63, but 996 / 999 / 996 converged against 997 / 999 / 996; the
+  // Random3D preset, 200 load cases of seed 90210: 198 against 200 converged. Near bifurcations
+  // another path is another outcome, and these lost more than they won: so it is off by default.
+  return opt_.abandon_off_path && may_leave_ && rtol > opt_.rtol && negative_pivots_ > std::max(pivots_at_start_, 0) &&
+         lambda < 0.3;
 }
 
 bool NonlinearSolver::inertia_at_final_state(std::string& why) {
@@ -245,11 +273,13 @@ bool NonlinearSolver::inertia_at_final_state(std::string& why) {
 }
 
 bool NonlinearSolver::increment(double d_next, bool last, int& its, std::string& why) {
+  left_path_ = false;
   return predict(d_next, why) && correct(d_next, last ? opt_.rtol : opt_.path_rtol, its, why);
 }
 
 bool NonlinearSolver::predict(double d_next, std::string& why) {
   LogEvent event(events().predictor);
+  pivots_at_start_ = negative_pivots_;
   // Tangent predictor to c . u = d_next: from an equilibrium at s, dalpha a is Newton's step
   // at the load s + dalpha. Taken with the guarded energy line search: never an inverted
   // state, and damped where a linearised large rotation would stretch a nearly
@@ -402,6 +432,7 @@ TargetResult NonlinearSolver::follow_path(double target, double start, int spent
   t.solves += rest.solves;
   t.newton_iterations += rest.newton_iterations;
   t.failed_increments += rest.failed_increments + rest.increments;
+  t.off_path_increments += rest.off_path_increments;
   t.recovery_iterations += rest.newton_iterations;
   t.seconds_first_solve = rest.seconds_first_solve;
   return t;
@@ -439,6 +470,7 @@ TargetResult NonlinearSolver::path(double target, double start, int spent, PathS
     const double s_backup = s_;
     const int its_before = its;
     ++t.solves;
+    may_leave_ = failed_in_a_row == 0;  // see off_the_path
     const bool ok = increment(d_next, last, its, why);
     if (t.solves == 1) t.seconds_first_solve = core::now_seconds() - start;
     HS_PETSC(PetscInfo(snes_.get(), "path to %g: %g -> %g%s: %s in %d Newton its (alpha %g)\n", target, d, d_next,
@@ -459,6 +491,7 @@ TargetResult NonlinearSolver::path(double target, double start, int spent, PathS
       continue;
     }
     ++t.failed_increments;
+    t.off_path_increments += left_path_;
     t.recovery_iterations += its - its_before;
     HS_PETSC(VecCopy(backup_, u_));
     HS_PETSC(VecCopy(a0_, a_));

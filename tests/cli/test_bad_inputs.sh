@@ -87,6 +87,7 @@ bad types attempts_range  2 "shapes.max_attempts: must be in [1, 1000]" "$(sub '
 bad types quality_angle   2 "shapes.quality.min_angle_deg: must be in [0, 60)" "$(sub 's/h: 0.2}/h: 0.2, quality: {min_angle_deg: 90}}/')"
 bad types rtol_zero       2 "solver.rtol: must be in (0, 1)" "$(add 'solver: {rtol: 0}')"
 bad types fallback_word   2 "solver.fallback: must be true or false" "$(add 'solver: {fallback: maybe}')"
+bad types off_path_word  2 "solver.abandon_off_path: must be true or false" "$(add 'solver: {abandon_off_path: 3}')"
 bad types linear_word     2 "solver.linear: must be auto, direct, gamg or hypre" "$(add 'solver: {linear: amg}')"
 
 # ---- sizes -------------------------------------------------------------------------------------

@@ -51,8 +51,10 @@ TEST_CASE("The path's increments end in the equilibrium a Newton solve at the sa
   }
   // The counts are deterministic: 123 Newton iterations and 10 failed increments on these five
   // paths when the step control (double after <= 2 corrector iterations, halve after >= 6) was
-  // introduced. More is a regression of the increments' cost.
+  // introduced. More is a regression of the increments' cost. (With abandon_off_path: 132 and
+  // 14, the locked P1 path at nu 0.4999 taking 68 -> 77 iterations.)
   INFO(its << " Newton iterations, " << failed << " failed increments");
   CHECK(its <= 123);
   CHECK(failed <= 10);
 }
+

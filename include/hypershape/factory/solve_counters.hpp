@@ -16,6 +16,7 @@ struct SolveCounters {
   std::int64_t newton_iterations = 0;    ///< all Newton iterations, failed increments' included
   std::int64_t solves = 0;               ///< increments tried (alpha evaluations under load control)
   std::int64_t failed_increments = 0;    ///< increments that failed and were halved
+  std::int64_t off_path_increments = 0;  ///< of those: abandoned off the path (an indefinite damped step)
   std::int64_t recovery_iterations = 0;  ///< Newton iterations spent in failed increments
   solver::LinearCounters linear;         ///< factorisations, Krylov iterations, tangent assemblies
 
