@@ -209,7 +209,8 @@ std::string petsc_help_intro() {
       "  `hypershape effects` lists the effects a scene may use.\n",
       d.rtol, d.max_newton, d.max_increments, d.target_rtol,
       d.control == solver::Control::displacement ? "displacement" : "load", d.path_rtol, d.newton_budget,
-      d.fallback, d.branch_switches, d.abandon_off_path, d.tangent.reuse, d.tangent.krylov_budget, d.tangent.krylov_rtol,
+      d.fallback, d.branch_switches, d.abandon_off_path, d.tangent.reuse, d.tangent.krylov_budget,
+      d.tangent.krylov_rtol,
       solver::to_string(d.tangent.linear), d.tangent.auto_dofs);
 }
 

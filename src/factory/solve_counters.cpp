@@ -12,8 +12,8 @@ constexpr std::size_t kCounters = 11;
 template <class C>
 auto fields(C& c) {
   return std::array{&c.loads_ok, &c.loads_failed, &c.newton_iterations, &c.solves, &c.failed_increments,
-          &c.off_path_increments, &c.recovery_iterations, &c.linear.numeric_factorizations, &c.linear.symbolic_factorizations,
-          &c.linear.krylov_iterations, &c.linear.tangent_assemblies};
+          &c.off_path_increments, &c.recovery_iterations, &c.linear.numeric_factorizations,
+          &c.linear.symbolic_factorizations, &c.linear.krylov_iterations, &c.linear.tangent_assemblies};
 }
 
 }  // namespace

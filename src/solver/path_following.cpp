@@ -252,8 +252,8 @@ bool NonlinearSolver::off_the_path(double rtol, double lambda) const {
   // 98 / 51 / 79 -> 99 / 42 / 63, but 996 / 999 / 996 converged against 997 / 999 / 996; the
   // Random3D preset, 200 load cases of seed 90210: 198 against 200 converged. Near bifurcations
   // another path is another outcome, and these lost more than they won: so it is off by default.
-  return opt_.abandon_off_path && may_leave_ && rtol > opt_.rtol && negative_pivots_ > std::max(pivots_at_start_, 0) &&
-         lambda < 0.3;
+  return opt_.abandon_off_path && may_leave_ && rtol > opt_.rtol &&
+         negative_pivots_ > std::max(pivots_at_start_, 0) && lambda < 0.3;
 }
 
 bool NonlinearSolver::inertia_at_final_state(std::string& why) {

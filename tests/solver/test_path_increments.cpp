@@ -57,4 +57,3 @@ TEST_CASE("The path's increments end in the equilibrium a Newton solve at the sa
   CHECK(its <= 123);
   CHECK(failed <= 10);
 }
-

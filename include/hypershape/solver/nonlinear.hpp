@@ -223,8 +223,9 @@ class NonlinearSolver {
   /// tangent response K^-1 f_ext of its last factorisation (the next predictor).
   bool correct(double d, double rtol, int& its, std::string& why);
   /// With abandon_off_path: whether a corrector iterate of an intermediate increment (`rtol` above
-  /// the final one), on the increment's first try, has left the path: its tangent has more negative pivots than at the
-  /// increment's start and the line search cut its step (`lambda`) below 0.3.
+  /// the final one), on the increment's first try, has left the path: its tangent has more
+  /// negative pivots than at the increment's start and the line search cut its step (`lambda`)
+  /// below 0.3.
   bool off_the_path(double rtol, double lambda) const;
   /// At the path's final state (converged to rtol): its tangent's inertia where the corrector's
   /// last factor does not give it (a kept factor, multigrid, LU). False with `why` on failure.
@@ -293,8 +294,8 @@ class NonlinearSolver {
   double s0_ = 0;       ///< load factor of the state a branch switch left (in v0_)
   int negative_pivots_ = -1;  ///< inertia of the last tangent_response() (-1: unknown)
   int pivots_at_start_ = -1;  ///< negative_pivots_ where the current increment started
-  bool left_path_ = false;
-  bool may_leave_ = true;     ///< off_the_path may end the increment (its last try did not fail)    ///< the last corrector stopped because off_the_path held
+  bool left_path_ = false;    ///< the last corrector stopped because off_the_path held
+  bool may_leave_ = true;     ///< off_the_path may end the increment (its last try did not fail)
   LinearCounters snes_linear_;  ///< factorisations of the SNES's own KSP (load control)
   bool user_atol_ = false;
 };
