@@ -7,6 +7,11 @@
 # Random2D 1000 x 50, Random3D 1000 x 20); writes every run's figures as JSON.
 #   scripts/bench_generate.sh [SHAPES] [LOADS] [REPEATS]    (JSON: results/bench_generate.json)
 #   PRESET=random3d scripts/bench_generate.sh 10 20 1       (a Random3D slice of 200 load cases)
+#   SEED=90210 ...                                          (another seed than the preset's)
+# Two projections of the full preset: from the slice's rate (its wall time; a small slice ends
+# with one rank idle while the other finishes the last shard), and from its work (phase seconds
+# summed over ranks, spread evenly over the ranks, plus one shard of the full run's size run
+# alone at the end: a bound on the full run's tail, where shards are handed out one at a time).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 shapes=${1:-20} loads=${2:-50} repeats=${3:-3}
@@ -15,7 +20,8 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 cat > "$work/slice.yaml" <<YAML
 preset: ${PRESET:-random2d}
-name: bench_${PRESET:-random2d}
+name: bench_${PRESET:-random2d}${SEED:+
+seed: $SEED}
 shapes: {count: $shapes}
 loads: {count: $loads}
 output: {shard_size: 2}
@@ -51,6 +57,10 @@ out["projected_hours_2_ranks_range"] = [full / max(rates[2]) / 3600, full / min(
 busy = {n: sum(r[n]["seconds"]["phases_summed_over_groups"].values()) for n in (1, 2)}
 out["work_per_load_case_2_vs_1"] = busy[2] / busy[1]
 out["idle_share_2_ranks"] = 1 - busy[2] / (2 * r[2]["seconds"]["wall"])
+work = {n: busy[n] / (shapes * loads) for n in (1, 2)}  # seconds per load case, summed over ranks
+shard = preset.get("output", {}).get("shard_size", 8) * preset["loads"]["count"]  # load cases per shard
+out["work_seconds_per_load_case"] = work
+out["projected_hours_full_from_work"] = {n: (full * work[n] + (n - 1) * shard * work[n]) / n / 3600 for n in (1, 2)}
 json.dump(out, open("results/bench_generate.json", "w"), indent=1)
 print(f"{name} slice: {shapes} shapes x {loads} load cases, {repeats} runs per rank count (alternated)")
 for n in (1, 2):
@@ -67,6 +77,9 @@ for n in (1, 2):
 print(f"2 ranks: {100 * out['efficiency_2_ranks']:.0f}% of twice the 1-rank rate (medians); full {name} on 2 ranks: "
       f"{out['projected_hours_full'][2]:.2f} h (runs: {out['projected_hours_2_ranks_range'][0]:.2f}-"
       f"{out['projected_hours_2_ranks_range'][1]:.2f} h)")
+print(f"From the work (phase seconds per load case {work[1]:.3f} on 1 rank, {work[2]:.3f} on 2, spread over the ranks, "
+      f"plus one shard of {shard} load cases alone at the end): full {name} {out['projected_hours_full_from_work'][1]:.2f} h "
+      f"on 1 rank, {out['projected_hours_full_from_work'][2]:.2f} h on 2")
 print(f"2 ranks lose {100 * (out['work_per_load_case_2_vs_1'] - 1):.1f}% to more work per load case (the ranks share "
       f"the machine) and {100 * out['idle_share_2_ranks']:.1f}% to time outside the phases (start-up, and the end of the slice: shards handed "
       f"out one at a time); without that tail: {100 / out['work_per_load_case_2_vs_1']:.0f}% of twice the 1-rank rate")

@@ -36,12 +36,17 @@ void parse_solver_block(const YamlBlock& sol, solver::SolverOptions& s) {
     if (!l) sol.fail("linear", "must be auto, direct, gamg or hypre");
     s.tangent.linear = *l;
   }
+  if (sol.has("factor_precision")) {
+    const std::string f = sol.text("factor_precision");
+    if (f != "double" && f != "single") sol.fail("factor_precision", "must be double or single");
+    s.tangent.single_factor = f == "single";
+  }
   if (sol.has("linear_auto_dofs")) s.tangent.auto_dofs = sol.integer("linear_auto_dofs");
   if (s.tangent.auto_dofs < 1) sol.fail("linear_auto_dofs", "must be >= 1 (unknowns from which auto picks gamg in 3D)");
   if (s.tangent.reuse && (s.tangent.linear == solver::LinearSolver::gamg || s.tangent.linear == solver::LinearSolver::hypre))
     sol.fail("factor_reuse", "must be false with linear: gamg or hypre (a kept factor is the direct solver's)");
   sol.allowed("rtol, max_newton, factor_reuse, krylov_budget, krylov_rtol, max_increments, target_rtol, control, path_rtol, newton_budget, fallback, "
-              "branch_switches, abandon_off_path, linear, linear_auto_dofs");
+              "branch_switches, abandon_off_path, linear, linear_auto_dofs, factor_precision");
   sol.check_all_used();
 }
 

@@ -297,7 +297,9 @@ void reduce_report(MPI_Comm comm, bool group_root, const core::PhaseTimes& times
   {
     PetscLogEvent ev;
     PetscEventPerfInfo info{};
-    if (PetscLogEventGetId("PCSetUp", &ev) == 0 && PetscLogEventGetPerfInfo(0, ev, &info) == 0) pc_setup = info.time;
+    // PETSc's factorisations are PCSetUp; the single-precision ones (SMUMPS) are not.
+    for (const char* name : {"PCSetUp", "HSFactorSingle"})
+      if (PetscLogEventGetId(name, &ev) == 0 && PetscLogEventGetPerfInfo(0, ev, &info) == 0) pc_setup += info.time;
   }
   // Counters: the group roots hold the group's numbers once.
   auto sum_roots = [&](std::int64_t v) {

@@ -97,7 +97,7 @@ core::KSPH make_factor_preconditioned_gmres(MPI_Comm comm, void* ctx, PetscError
   return ksp;
 }
 
-LdltFactor::LdltFactor(const physics::Problem& problem, const std::string& prefix, bool symmetric)
+LdltFactor::LdltFactor(const physics::Problem& problem, const std::string& prefix, bool symmetric, bool single)
     : symmetric_(symmetric) {
   HS_PETSC(KSPCreate(problem.comm(), ksp_.out()));
   if (!prefix.empty()) HS_PETSC(KSPSetOptionsPrefix(ksp_, prefix.c_str()));
@@ -106,9 +106,14 @@ LdltFactor::LdltFactor(const physics::Problem& problem, const std::string& prefi
   // (the options keep their meaning: the general kind reads them).
   PetscMPIInt ranks;
   MPI_Comm_size(problem.comm(), &ranks);
-  blocked_ = symmetric && ranks == 1 && problem.space().dim() == 2 && !option_given(prefix, "-pc_factor_mat_solver_type") &&
-             !option_given(prefix, "-pc_factor_mat_ordering_type") && !option_given(prefix, "-pc_type") &&
-             !option_given(prefix, "-ksp_type");
+  const bool own_kind = symmetric && ranks == 1 && !option_given(prefix, "-pc_factor_mat_solver_type") &&
+                        !option_given(prefix, "-pc_factor_mat_ordering_type") && !option_given(prefix, "-pc_type") &&
+                        !option_given(prefix, "-ksp_type");
+  if (own_kind && single) {
+    single_ = std::make_unique<SingleFactor>();
+    return;
+  }
+  blocked_ = own_kind && problem.space().dim() == 2;
   if (blocked_) {
     PC pc;
     HS_PETSC(KSPGetPC(ksp_, &pc));
@@ -223,6 +228,10 @@ void LdltFactor::scatter_values(Mat A) {
 }
 
 bool LdltFactor::factorise(Mat A) {
+  if (single_) {
+    analysed_ = true;
+    return factored_ = single_->factorise(A);
+  }
   if (!analysed_ && blocked_) set_up_blocked(A);
   analysed_ = true;
   if (!blocked_ && !F_) {
@@ -244,6 +253,7 @@ bool LdltFactor::factorise(Mat A) {
 }
 
 bool LdltFactor::solve(Vec b, Vec x) {
+  if (single_) return single_->solve(b, x);
   KSPConvergedReason r;
   if (!blocked_) {
     HS_PETSC(KSPSolve(ksp_, b, x));
@@ -294,6 +304,7 @@ void LdltFactor::refine() {
 }
 
 int LdltFactor::negative_eigenvalues() const {
+  if (single_) return single_->negative_eigenvalues();
   return factored_ ? solver::negative_eigenvalues(ksp_) : -1;
 }
 

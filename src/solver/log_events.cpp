@@ -19,6 +19,7 @@ const Events& events() {
     HS_PETSC(PetscLogEventRegister("HSLoadControl", cls, &r.load_control));
     HS_PETSC(PetscLogEventRegister("HSAMGSetup", cls, &r.multigrid_setup));
     HS_PETSC(PetscLogEventRegister("HSStability", cls, &r.stability));
+    HS_PETSC(PetscLogEventRegister("HSFactorSingle", cls, &r.single_factor));
     return r;
   }();
   return e;

@@ -3,14 +3,15 @@
 /// HSTangentAsm (tangent assemblies), HSFactor (numeric factorisations, symbolic included on
 /// the first), HSFactorSolve (direct solves with a factor), HSKrylov (Newton-Krylov solves),
 /// HSPredictor / HSCorrector (the displacement-controlled path), HSBranchSwitch, HSLoadControl,
-/// HSAMGSetup (multigrid set-ups of a tangent), HSStability (the multigrid kind's LOBPCG check).
+/// HSAMGSetup (multigrid set-ups of a tangent), HSStability (the multigrid kind's LOBPCG check),
+/// HSFactorSingle (numeric single-precision factorisations, SMUMPS: not a PCSetUp).
 #include <petsclog.h>
 
 namespace hypershape::solver {
 
 struct Events {
   PetscLogEvent tangent_assembly, factorisation, factor_solve, krylov, predictor, corrector,
-      branch_switch, load_control, multigrid_setup, stability;
+      branch_switch, load_control, multigrid_setup, stability, single_factor;
 };
 
 /// Registered on first use (PETSc must be initialised). Not collective.

@@ -445,11 +445,10 @@ TargetResult NonlinearSolver::path(double target, double start, int spent, PathS
   const bool fresh = d == 0 && s_ == 0;  // a load case's start (not a branch switch's)
   const bool ready = how == PathStart::fixed_loads && start_under_fixed_loads(target, its);
   const double d_start = d = problem_.max_displacement(u_);
-  // From rest in 2D, K(0) is factorised once per problem. Not in 3D: a second MUMPS factor
-  // there doubles the factor memory (hundreds of MiB per rank at the 3D presets' sizes) for
-  // one factorisation in about ten per load case.
+  // From rest, K(0) is factorised once per problem where a second factor is cheap to keep
+  // (Tangent::use_rest_factor: in 2D, and in 3D with single-precision factors).
   const bool from_rest = d == 0;
-  if (!ready && !(from_rest && problem_.space().dim() == 2 ? rest_response() : tangent_response(false))) {
+  if (!ready && !(from_rest ? rest_response() : tangent_response(false))) {
     t.reason = "tangent factorisation or solve failed at the start";
     return t;
   }

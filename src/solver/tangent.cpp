@@ -52,7 +52,7 @@ Tangent::Tangent(const physics::Problem& problem, const TangentOptions& opt, con
     set_rigid_body_near_null_space(problem, J_);
     amg_ = make_multigrid_ksp(problem.comm(), linear_, prefix);
   }
-  work_ = std::make_unique<LdltFactor>(problem, prefix, !lu());
+  work_ = std::make_unique<LdltFactor>(problem, prefix, !lu(), opt_.single_factor);
   krylov_ = make_factor_preconditioned_gmres(problem.comm(), this, apply_shell, "kept LDL^T factor of an earlier tangent");
   HS_PETSC(KSPSetOptionsPrefix(krylov_, (prefix + "tangent_").c_str()));
   HS_PETSC(KSPGMRESSetRestart(krylov_, 40));
@@ -100,13 +100,14 @@ bool Tangent::factorise() {
 }
 
 bool Tangent::use_rest_factor(Vec rest) {
-  if (problem_.space().dim() != 2 || lu()) return false;
+  // In 3D only where the factors are single precision: two of them hold what one double did.
+  if (lu() || (problem_.space().dim() != 2 && !work_->single())) return false;
   if (!rest_) {
     LogEvent e(events().factorisation);
     J0_ = problem_.create_matrix();
     ++n_.tangent_assemblies;
     if (!problem_.jacobian(rest, J0_)) return false;
-    rest_ = std::make_unique<LdltFactor>(problem_, prefix_);
+    rest_ = std::make_unique<LdltFactor>(problem_, prefix_, true, opt_.single_factor);
     ++n_.symbolic_factorizations;
     ++n_.numeric_factorizations;  // once per problem
     if (!rest_->factorise(J0_)) {

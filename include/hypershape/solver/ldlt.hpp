@@ -14,16 +14,20 @@
 ///  - general (3D, solver groups, or another factorisation asked for in the options): a copy of
 ///    the matrix factored by a preonly Cholesky KSP (configure_direct_solver; the KSP's options
 ///    prefix applies), inertia from MUMPS's INFOG(12) or MatGetInertia.
+///  - single (asked for with `single`, symmetric, one rank): MUMPS's single-precision factor,
+///    solves refined to double precision (single_factor.hpp); inertia from its pivots.
 ///  - LU (symmetric = false: a tangent with a follower load's stiffness): a copy of the matrix
 ///    factored by a preonly LU KSP, PETSc's own LU in 2D on one rank, MUMPS otherwise. No inertia
 ///    (an LU factor has none): negative_eigenvalues() is -1.
 #include <petscksp.h>
 
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "hypershape/core/petsc_handle.hpp"
 #include "hypershape/physics/problem.hpp"
+#include "hypershape/solver/single_factor.hpp"
 
 namespace hypershape::solver {
 
@@ -45,7 +49,9 @@ core::KSPH make_factor_preconditioned_gmres(MPI_Comm comm, void* ctx, PetscError
 class LdltFactor {
  public:
   /// Collective. `prefix`: options prefix of the factor's KSP. `symmetric` false: an LU factor.
-  LdltFactor(const physics::Problem& problem, const std::string& prefix, bool symmetric = true);
+  /// `single`: the mixed-precision kind where it applies (symmetric, one rank, no factorisation
+  /// options given), the others otherwise.
+  LdltFactor(const physics::Problem& problem, const std::string& prefix, bool symmetric = true, bool single = false);
   LdltFactor(const LdltFactor&) = delete;
   LdltFactor& operator=(const LdltFactor&) = delete;
 
@@ -58,6 +64,7 @@ class LdltFactor {
   int negative_eigenvalues() const;
   bool factored() const { return factored_; }
   bool blocked() const { return blocked_; }
+  bool single() const { return single_ != nullptr; }
   /// The factor's KSP (preonly Cholesky) and the matrix it factors.
   KSP ksp() const { return ksp_.get(); }
 
@@ -84,6 +91,7 @@ class LdltFactor {
   std::vector<PetscInt> value_map_;
   core::VecH xp_, yp_, rp_;  ///< b, x and the residual in the new ordering
   core::KSPH refine_;
+  std::unique_ptr<SingleFactor> single_;  ///< the single kind (then F_ and ksp_ are unused)
 };
 
 }  // namespace hypershape::solver

@@ -16,10 +16,12 @@
 /// converge within what is left of it. Both rules count iterations, never seconds: the
 /// sequence of factorisations, and so the data, is the same on every run.
 ///
-/// Slots: the factor in use is either the work factor (refreshed as above) or, in 2D, the
-/// factor of K(0) (the state every load case starts from; dead loads, so the same for every
-/// load case of the problem), made once per problem and kept. In 3D a second MUMPS factor would
-/// double the factor memory, so a load case starts from whatever work factor the last one left.
+/// Slots: the factor in use is either the work factor (refreshed as above) or the factor of K(0)
+/// (the state every load case starts from; dead loads, so the same for every load case of the
+/// problem), made once per problem and kept: in 2D, and in 3D where the factors are single
+/// precision (TangentOptions::single_factor; two single factors take the memory of one double).
+/// A 3D double factor is not doubled (hundreds of MiB per rank at the 3D presets' sizes for one
+/// factorisation in about fifteen per load case): a load case factorises K(0) anew.
 ///
 /// Counters (numeric and symbolic factorisations, Krylov iterations, tangent assemblies) are
 /// counted where they happen; log events make -log_view show the split.
@@ -73,6 +75,11 @@ struct TangentOptions {
   /// of at least `auto_dofs` unknowns, the direct LDL^T otherwise.
   LinearSolver linear = LinearSolver::automatic;
   std::int64_t auto_dofs = 150000;
+  /// The factorisation in single precision, its solves refined to double (single_factor.hpp;
+  /// config `solver: {factor_precision: single}`): symmetric tangents on one rank only (a solver
+  /// group and an LU factor keep double). The answers agree with double's to the Newton tolerance,
+  /// not bit for bit.
+  bool single_factor = false;
 };
 
 class Tangent {
