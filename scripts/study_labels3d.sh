@@ -5,6 +5,7 @@
 #   scripts/study_labels3d.sh [ball|r3d-0 ...]      (default: both; ~15-30 min each on a shared 2-core VM)
 #   DILATATION=mean scripts/study_labels3d.sh        (the mean-dilatation element's study)
 #   STUDY=large_loads | STUDY=share scripts/study_labels3d.sh   (alpha 15/30; pointwise_share)
+#   STUDY=surface022 scripts/study_labels3d.sh       (the random3d preset's mesh of 2026-11-26)
 # Output: results/labels3d/<scene>.json, results/labels3d/<scene>_ref*.h5 (for
 # scripts/check_labels3d_dolfinx.py), and the tables (scripts/labels3d_table.py).
 set -euo pipefail
@@ -36,6 +37,21 @@ if [ "${STUDY:-}" = large_loads ] || [ "${STUDY:-}" = share ]; then
         -d s0.2i0.3rim10m:surface_h=0.2,interior_h=0.3,$r$m -d s0.2i0.3rim10s05:surface_h=0.2,interior_h=0.3,$r$m,share=0.05 \
         --out "results/labels3d/${scene}_share_alpha5.json"
     fi
+  done
+  exit 0
+fi
+if [ "${STUDY:-}" = surface022 ]; then
+  # docs/ACCURACY.md, "The random3d preset moved again": surfaces of 0.2-0.22 over a 0.25-0.35
+  # interior, the rim at 0.1-0.125, against refm0.0125 -> results/labels3d/<scene>_mean_s022.json
+  m=",dilatation=mean"
+  for scene in "${scenes[@]}"; do
+    "$build/study_labels3d" --scene "$scene" --reference refm0.0125 \
+      -d refm0.0125:surface_h=0.1,interior_h=0.3,rim=0.0125,load=0.0125,grading=0.4$m \
+      -d rim0.25m10:h=0.25,rim=0.1$m -d s0.2i0.3rim10m:surface_h=0.2,interior_h=0.3,rim=0.1$m \
+      -d s0.22i0.3rim10m:surface_h=0.22,interior_h=0.3,rim=0.1$m -d s0.2i0.3rim12m:surface_h=0.2,interior_h=0.3,rim=0.125$m \
+      -d s0.22i0.3rim12m:surface_h=0.22,interior_h=0.3,rim=0.125$m -d s0.22i0.25rim10m:surface_h=0.22,interior_h=0.25,rim=0.1$m \
+      -d s0.2i0.35rim12m:surface_h=0.2,interior_h=0.35,rim=0.125$m \
+      --out "results/labels3d/${scene}_mean_s022.json" 2>&1 | tee "results/labels3d/${scene}_mean_s022.log"
   done
   exit 0
 fi

@@ -395,7 +395,9 @@ void parse_mesh(const YamlBlock& top, const std::string& source, DatasetConfig& 
     const double mh = std::max(c.shapes.h, c.shapes.mesh_h);
     if (!(sh >= c.shapes.h && sh <= mh))
       m.fail("surface_h", fmt::format("must be in [shapes.h = {:g}, mesh.h = {:g}] (shapes.h: the surface "
-                                      "as drawn, with a coarser interior)", c.shapes.h, mh));
+                                      "as drawn, with a coarser interior; a preset's surface_h (random3d: "
+                                      "0.22) stays under a finer mesh.h you set: set surface_h too)",
+                                      c.shapes.h, mh));
     c.shapes.surface_h = sh;
   }
   if (m.has("rim")) {

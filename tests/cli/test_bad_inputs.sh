@@ -88,6 +88,8 @@ bad types quality_angle   2 "shapes.quality.min_angle_deg: must be in [0, 60)" "
 bad types rtol_zero       2 "solver.rtol: must be in (0, 1)" "$(add 'solver: {rtol: 0}')"
 bad types fallback_word   2 "solver.fallback: must be true or false" "$(add 'solver: {fallback: maybe}')"
 bad types off_path_word  2 "solver.abandon_off_path: must be true or false" "$(add 'solver: {abandon_off_path: 3}')"
+bad types factor_half    2 "solver.factor_precision: must be double or single" "$(add 'solver: {factor_precision: half}')"
+bad types r3_finer_mesh  2 "mesh.surface_h: must be in [shapes.h = 0.1, mesh.h = 0.2]" "$(sub 's/^preset: random2d/preset: random3d/; s/shapes: {count: 2, h: 0.2}/shapes: {count: 1}\nmesh: {h: 0.2}/')"
 bad types linear_word     2 "solver.linear: must be auto, direct, gamg or hypre" "$(add 'solver: {linear: amg}')"
 
 # ---- sizes -------------------------------------------------------------------------------------

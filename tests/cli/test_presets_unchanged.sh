@@ -10,10 +10,12 @@
 # other array still matches the pre-issue-17 runs to 1e-9. On 2026-11-25 the random3d preset
 # moved (P2 at 0.25 with the clamp rim at 0.1 and the mean dilatation, issue 16): preset_r3.yaml
 # now writes the former preset out (only its stored config text was updated), and preset_r3m
-# is the preset itself, fingerprinted when it moved.
+# is the preset itself, fingerprinted when it moved. On 2026-11-26 it moved again (surface 0.22,
+# interior 0.3, rim 0.125, single-precision factors): preset_r3m writes the 2026-11-25 preset
+# out, and preset_r3s is the preset, fingerprinted when it moved.
 # Needs HYPERSHAPE_BIN and HYPERSHAPE_SOURCE_DIR (set by CTest).
 . "$(dirname "$0")/lib.sh"
-for name in r2 e2 r3 r3m; do
+for name in r2 e2 r3 r3m r3s; do
   cfg="$src/tests/cli/expected/preset_$name.yaml"
   "$bin" -q generate "$cfg" --progress 0 -o "$work/$name" || { fail "$name: generate"; continue; }
   if out=$(/usr/bin/python3 "$src/tests/cli/dataset_fingerprint.py" "$work/$name" \

@@ -105,7 +105,7 @@ TEST_CASE("mesh.h: a 3D mesh coarser than its shape, checked", "[config][presets
   CHECK(c.shapes.mesh_h == 0.3);
   CHECK(c.degree == 2);
   // The 3D presets set it (merged under an override of the degree alone); 2D ones do not.
-  CHECK(by_name("preset: random3d\nmesh: {degree: 1}\n").shapes.mesh_h == 0.25);
+  CHECK(by_name("preset: random3d\nmesh: {degree: 1}\n").shapes.mesh_h == 0.3);
   CHECK(by_name("preset: liver\n").shapes.mesh_h == 0.2);
   CHECK(by_name("preset: random2d\n").shapes.mesh_h == 0.0);
   CHECK_THAT(error_of("preset: random2d\nmesh: {h: 0.1}\n"),
@@ -126,8 +126,11 @@ TEST_CASE("random3d labels with the mean dilatation; material.dilatation is the 
   const auto r3 = by_name("preset: random3d\n");
   CHECK(r3.material.dilatation == "mean");
   CHECK(dilatation(r3) == "mean");
-  CHECK(r3.shapes.mesh_h == 0.25);
-  CHECK(r3.shapes.rim_size == 0.1);
+  CHECK(r3.shapes.mesh_h == 0.3);
+  CHECK(r3.shapes.surface_h == 0.22);
+  CHECK(r3.shapes.rim_size == 0.125);
+  CHECK(r3.solver.tangent.single_factor);
+  CHECK_FALSE(by_name("preset: random2d\n").solver.tangent.single_factor);
   // The other presets' scenes are what they were: no dilatation key at all.
   CHECK(dilatation(by_name("preset: random2d\n")) == "(none)");
   CHECK(dilatation(by_name("preset: aug_liver\n")) == "(none)");

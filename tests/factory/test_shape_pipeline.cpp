@@ -203,7 +203,8 @@ TEST_CASE("a 3D mesh coarser than its shape (mesh_h): same draw, surface remeshe
   auto cfg = preset("random3d");
   cfg.shapes.h = 0.1;
   cfg.shapes.mesh_h = 0.0;
-  cfg.shapes.rim_size = 0.0;  // the coarse surface alone (the preset also refines its clamp rim)
+  cfg.shapes.rim_size = 0.0;  // the coarse surface alone (the preset also refines its clamp rim
+  cfg.shapes.surface_h = 0.0;  // and remeshes its surface finer than its interior)
   const auto fine = factory::make_shape(cfg.shapes, std::nullopt, cfg.seed, 0);
   cfg.shapes.mesh_h = 0.3;
   const auto coarse = factory::make_shape(cfg.shapes, std::nullopt, cfg.seed, 0);
