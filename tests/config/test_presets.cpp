@@ -131,6 +131,8 @@ TEST_CASE("random3d labels with the mean dilatation; material.dilatation is the 
   CHECK(r3.shapes.rim_size == 0.125);
   CHECK(r3.solver.tangent.single_factor);
   CHECK_FALSE(by_name("preset: random2d\n").solver.tangent.single_factor);
+  for (const char* n : {"aug_liver", "liver", "one_liver"})  // every 3D preset factorises in single precision
+    CHECK(by_name(std::string("preset: ") + n + "\n").solver.tangent.single_factor);
   // The other presets' scenes are what they were: no dilatation key at all.
   CHECK(dilatation(by_name("preset: random2d\n")) == "(none)");
   CHECK(dilatation(by_name("preset: aug_liver\n")) == "(none)");
