@@ -17,21 +17,8 @@
 
 using namespace hypershape;
 
-namespace {
-
-std::vector<physics::EffectPtr> ball_effects() {
-  std::vector<physics::EffectPtr> e;
-  e.push_back(physics::make_neo_hookean(500.0, 0.49));
-  e.push_back(physics::make_dirichlet_patch({1.0, 0.0, 0.0}, 0.5));
-  e.push_back(physics::make_gaussian_traction({-1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, 0.2));
-  return e;
-}
-
-
-}  // namespace
-
 TEST_CASE("GAMG and BoomerAMG reach the direct solver's equilibrium on the ball, without factorising", "[solver]") {
-  physics::Problem p{PETSC_COMM_WORLD, hstest::ball_mesh(0.4), ball_effects(), hstest::degree(2)};
+  physics::Problem p{PETSC_COMM_WORLD, hstest::ball_mesh(0.4), hstest::ball_effects(), hstest::degree(2)};
   solver::SolverOptions direct;
   direct.tangent.linear = solver::LinearSolver::direct;
   solver::NonlinearSolver ref(p, direct);
@@ -69,7 +56,7 @@ TEST_CASE("auto picks the multigrid solver in 3D from its size, the direct one b
 TEST_CASE("LOBPCG preconditioned by GAMG settles the sign of the tangent's smallest eigenvalue", "[solver]") {
   // The ball's tangent at rest (P1, h 0.5: small enough for dense eigenvalues), shifted below,
   // between and above its smallest eigenvalues: the sign the factor's inertia would give.
-  physics::Problem p{PETSC_COMM_WORLD, hstest::ball_mesh(0.5), ball_effects(), hstest::degree(1)};
+  physics::Problem p{PETSC_COMM_WORLD, hstest::ball_mesh(0.5), hstest::ball_effects(), hstest::degree(1)};
   core::VecH u = p.create_vector();
   core::MatH K = p.create_matrix();
   REQUIRE(p.jacobian(u, K));

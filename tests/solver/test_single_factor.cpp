@@ -17,14 +17,6 @@ using namespace hypershape;
 
 namespace {
 
-std::vector<physics::EffectPtr> ball_effects() {
-  std::vector<physics::EffectPtr> e;
-  e.push_back(physics::make_neo_hookean(500.0, 0.49));
-  e.push_back(physics::make_dirichlet_patch({1.0, 0.0, 0.0}, 0.5));
-  e.push_back(physics::make_gaussian_traction({-1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, 0.2));
-  return e;
-}
-
 double relative_residual(Mat A, Vec b, Vec x) {
   core::VecH r;
   HS_PETSC(VecDuplicate(b, r.out()));
@@ -42,21 +34,13 @@ TEST_CASE("The single-precision LDL^T solves to double precision and counts MUMP
   // K - sigma I of a 3D P2 tangent (nu 0.49: condition ~1e5, so a single-precision solve alone
   // is good to a few digits), definite and indefinite. One factor, refactorised in place (the
   // analysis once): a stale factor would fail the next shift's comparison.
-  physics::Problem p{PETSC_COMM_WORLD, hstest::ball_mesh(0.5), ball_effects(), hstest::degree(2)};
+  physics::Problem p{PETSC_COMM_WORLD, hstest::ball_mesh(0.5), hstest::ball_effects(), hstest::degree(2)};
   core::VecH u = p.create_vector(), x = p.create_vector(), y = p.create_vector();
   core::MatH K = p.create_matrix();
   REQUIRE(p.jacobian(u, K));
   solver::LdltFactor single(p, "", true, true);
   REQUIRE(single.single());
-  PetscReal diag_mean;
-  {
-    core::VecH d = p.create_vector();
-    HS_PETSC(MatGetDiagonal(K, d));
-    HS_PETSC(VecSum(d, &diag_mean));
-    PetscInt n;
-    HS_PETSC(VecGetSize(d, &n));
-    diag_mean /= double(n);
-  }
+  const double diag_mean = hstest::mean_diagonal(K);
   for (const double shift : {0.0, 0.05, 0.3, 0.0}) {
     core::MatH S;
     HS_PETSC(MatDuplicate(K, MAT_COPY_VALUES, S.out()));
@@ -82,7 +66,7 @@ TEST_CASE("The single-precision LDL^T solves to double precision and counts MUMP
 }
 
 TEST_CASE("factor_precision single reaches the double factor's equilibrium on the ball and keeps K(0)", "[solver]") {
-  physics::Problem p{PETSC_COMM_WORLD, hstest::ball_mesh(0.4), ball_effects(), hstest::degree(2)};
+  physics::Problem p{PETSC_COMM_WORLD, hstest::ball_mesh(0.4), hstest::ball_effects(), hstest::degree(2)};
   solver::NonlinearSolver dbl(p, solver::SolverOptions{});
   solver::SolverOptions opt;
   opt.tangent.single_factor = true;

@@ -377,15 +377,7 @@ TEST_CASE("The blocked LDL^T (2x2 nodes, AMD ordering) solves as MUMPS does and 
     core::MatH K = p.create_matrix();
     REQUIRE(p.jacobian(u, K));
     solver::LdltFactor blocked(p, "");
-    PetscReal diag_mean;
-    {
-      core::VecH d = p.create_vector();
-      HS_PETSC(MatGetDiagonal(K, d));
-      HS_PETSC(VecSum(d, &diag_mean));
-      PetscInt n;
-      HS_PETSC(VecGetSize(d, &n));
-      diag_mean /= double(n);
-    }
+    const double diag_mean = hstest::mean_diagonal(K);
     for (const double shift : {0.0, 0.05, 0.2, 0.6}) {
       core::MatH S;
       HS_PETSC(MatDuplicate(K, MAT_COPY_VALUES, S.out()));

@@ -159,6 +159,28 @@ inline hs::mesh::MeshData ball_mesh(double h) {
   return hs::mesh::mesh_ball(mo, hs::mesh::ClampRegion{{1.0, 0.0, 0.0}, 0.5});
 }
 
+/// The seed paper's 3D scene on ball_mesh: Neo-Hookean E = 500, nu = 0.49, clamped near (1, 0, 0)
+/// (r = 0.5), Gaussian traction at (-1, 0, 0) pointing in +y (gamma 0.2).
+inline std::vector<hs::physics::EffectPtr> ball_effects() {
+  std::vector<hs::physics::EffectPtr> e;
+  e.push_back(hs::physics::make_neo_hookean(500.0, 0.49));
+  e.push_back(hs::physics::make_dirichlet_patch({1.0, 0.0, 0.0}, 0.5));
+  e.push_back(hs::physics::make_gaussian_traction({-1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, 0.2));
+  return e;
+}
+
+/// The mean of A's diagonal (a scale for shifts that make a tangent indefinite). Collective.
+inline double mean_diagonal(Mat A) {
+  hs::core::VecH d;
+  HS_PETSC(MatCreateVecs(A, d.out(), nullptr));
+  HS_PETSC(MatGetDiagonal(A, d));
+  PetscReal sum;
+  PetscInt n;
+  HS_PETSC(VecSum(d, &sum));
+  HS_PETSC(VecGetSize(d, &n));
+  return sum / double(n);
+}
+
 /// Negative eigenvalues of the symmetric matrix A by a fresh LDL^T of `package` (MUMPS, PETSc).
 inline int ldlt_negative_eigenvalues(Mat A, const char* package) {
   KSP ksp;
