@@ -38,7 +38,7 @@ void trial_solve(const config::DatasetConfig& cfg) {
   LabelErrors errors(cfg, 1);
   if (r.converged && errors.enabled())
     errors.estimate(PETSC_COMM_SELF, cfg, shape, lc, lc, *sp.problem, nl.solution(), r.alpha,
-                    [&](Vec x, Vec y) { return nl.apply_tangent_factor(x, y); });
+                    [&](Vec x, Vec y, bool refined) { return nl.apply_tangent_factor(x, y, refined); });
 }
 
 /// Options PETSc reads only in PetscFinalize (or at start-up, for the whole process): no

@@ -491,7 +491,7 @@ ShapeSolve solve_shape(MPI_Comm group, const config::DatasetConfig& cfg, const S
         auto t = out.times.scope("error_estimate");
         // The coarse level: the factor the solve left (no second coarse factorisation).
         label_errors.estimate(group, cfg, shape, cases[0], cases[L], *sp.problem, nl->solution(), o.result.alpha,
-                              [&](Vec x, Vec y) { return nl->apply_tangent_factor(x, y); });
+                              [&](Vec x, Vec y, bool refined) { return nl->apply_tangent_factor(x, y, refined); });
       }
       if (root) {
         auto t = out.times.scope("representations");

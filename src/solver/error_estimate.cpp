@@ -268,17 +268,21 @@ namespace {
 /// interpolation P, one symmetric Gauss-Seidel sweep before and after on the fine level
 /// (Richardson/SOR: no eigenvalue estimate per operator, which Chebyshev/Jacobi spent ten fine
 /// products on at every estimate). Options with prefix "error_estimate_".
+constexpr PetscInt kFineKrylovBudget = 40;
+
 core::KSPH two_grid_solver(MPI_Comm comm, Mat Kf, Mat Kc, Mat P, PetscErrorCode (*coarse_apply)(PC, Vec, Vec), void* ctx) {
   core::KSPH ksp;
   HS_PETSC(KSPCreate(comm, ksp.out()));
   HS_PETSC(KSPSetType(ksp, KSPGMRES));
   HS_PETSC(KSPSetOperators(ksp, Kf, Kf));
-  HS_PETSC(KSPSetTolerances(ksp, 1e-2, 1e-30, PETSC_DEFAULT, 300));
-  // Unrestarted: the mean-dilatation tangent of the random3d preset (nu 0.49, a cell-rank-one
-  // bulk term the point smoother barely touches) took up to 209 iterations, and GMRES(30) stalled
-  // at the 300-iteration cap on 2 of 6 load cases (no estimate); GMRES(100) on 1. The basis costs
-  // 300 fine vectors (~230 MB at the preset's ~95k fine unknowns) when all are used.
-  HS_PETSC(KSPGMRESSetRestart(ksp, 300));
+  // A budget of 40 unrestarted iterations; a step that spends it is kept (fine_step). On the
+  // random3d preset's mean-dilatation tangents (nu 0.49: a stiff rank-one bulk term per cell that
+  // the point smoother barely touches) GMRES to rtol 1e-2 took a median 32 and up to 300
+  // iterations; stopped at 40, the estimates moved by a median 0% (p10-p90 -12% to +5%) and cost
+  // half as much (docs/ACCURACY.md). A vertex-star Schwarz smoother was tried against the bulk
+  // term and diverged: the fine tangent at P u_h is indefinite on 2% of the stars.
+  HS_PETSC(KSPSetTolerances(ksp, 1e-2, 1e-30, PETSC_DEFAULT, kFineKrylovBudget));
+  HS_PETSC(KSPGMRESSetRestart(ksp, kFineKrylovBudget));
   PC pc;
   HS_PETSC(KSPGetPC(ksp, &pc));
   HS_PETSC(PCSetType(pc, PCMG));
@@ -398,7 +402,10 @@ double TwoLevelEstimator::fine_step(Vec x, Vec r, double alpha, bool first, bool
   HS_PETSC(KSPGetIterationNumber(ksp_, &its));
   out.krylov_iterations += int(its);
   HS_PETSC(PetscInfo(ksp_.get(), "error estimate: fine step: KSP reason %d in %d its\n", int(reason), int(its)));
-  if (reason <= 0) return -1;
+  // At the budget: GMRES's iterate (the least preconditioned residual over its space) is kept,
+  // and the energy line search judges it as any step.
+  if (reason == KSP_DIVERGED_ITS) out.krylov_budget_spent = true;
+  if (reason <= 0 && reason != KSP_DIVERGED_ITS) return -1;
   double lambda = energy_search(x, dx, alpha, w, out);
   fell_back = false;
   if (lambda == 0 && first) {
@@ -463,10 +470,10 @@ bool TwoLevelEstimator::fine_newton(Vec Pu, double alpha, Vec e, ErrorEstimate& 
   return true;
 }
 
-void TwoLevelEstimator::coarse_apply(Vec x, Vec y) const {
+void TwoLevelEstimator::coarse_apply(Vec x, Vec y, bool refined) const {
   bool ok = false;
   if (coarse_solve_) {
-    ok = coarse_solve_(x, y);
+    ok = coarse_solve_(x, y, refined);
   } else {
     KSPConvergedReason reason;
     HS_PETSC(KSPSolve(direct_, x, y));
@@ -484,7 +491,7 @@ PetscErrorCode TwoLevelEstimator::apply_coarse(PC pc, Vec x, Vec y) {
   const TwoLevelEstimator* self = nullptr;
   PetscCall(PCShellGetContext(pc, &self));
   try {
-    self->coarse_apply(x, y);
+    self->coarse_apply(x, y, false);
   } catch (const std::exception&) {  // a PETSc error inside the caller's solve: no estimate
     self->coarse_failed_ = true;
     PetscCall(VecZeroEntries(y));
@@ -531,7 +538,7 @@ ErrorEstimate TwoLevelEstimator::estimate(Vec u_h, double alpha, const CoarseSol
   HS_PETSC(VecZeroEntries(a));
   bool ok = prepare_coarse(u_h, coarse_solve, out) && fine_newton(Pu, alpha, e, out);
   // du/dalpha = K_c^-1 f_ext on the coarse level's factor (a back-solve).
-  if (ok) coarse_apply(coarse_.load(), a);
+  if (ok) coarse_apply(coarse_.load(), a, true);
   if (coarse_failed_) HS_PETSC(PetscInfo(ksp_.get(), "error estimate: the coarse solve failed\n"));
   ok = ok && !coarse_failed_;
   coarse_solve_ = nullptr;

@@ -213,8 +213,8 @@ LinearCounters NonlinearSolver::linear_counters() const {
   return n;
 }
 
-bool NonlinearSolver::apply_tangent_factor(Vec x, Vec y) {
-  return !tangent_->multigrid() && tangent_->has_factor() && tangent_->apply_factor(x, y);
+bool NonlinearSolver::apply_tangent_factor(Vec x, Vec y, bool refined) {
+  return !tangent_->multigrid() && tangent_->has_factor() && tangent_->apply_factor(x, y, refined);
 }
 
 bool NonlinearSolver::rest_response() {

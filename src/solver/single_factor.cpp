@@ -115,6 +115,15 @@ PetscErrorCode SingleFactor::apply(PC pc, Vec x, Vec y) {
   PetscFunctionReturn(0);
 }
 
+bool SingleFactor::solve_unrefined(Vec b, Vec x) {
+  steps_ = 0;
+  if (!factored_) return false;
+  solve_single(b, x);
+  PetscReal n;
+  HS_PETSC(VecNorm(x, NORM_2, &n));
+  return std::isfinite(n);
+}
+
 bool SingleFactor::solve(Vec b, Vec x) {
   steps_ = 0;
   if (!factored_) return false;

@@ -121,9 +121,9 @@ bool Tangent::use_rest_factor(Vec rest) {
   return true;
 }
 
-bool Tangent::apply_factor(Vec x, Vec y) {
+bool Tangent::apply_factor(Vec x, Vec y, bool refined) {
   LogEvent e(events().factor_solve);
-  return factor().solve(x, y);
+  return refined ? factor().solve(x, y) : factor().precondition(x, y);
 }
 
 int Tangent::negative_eigenvalues() {

@@ -149,7 +149,7 @@ void run_shape(const config::DatasetConfig& cfg, const factory::ShapeSample& sha
     j["newton_iterations"] = r.newton_iterations;
     if (r.converged) {
       const auto e = est.estimate(cfg, lc, nl.solution(), r.alpha,
-                                  [&](Vec x, Vec y) { return nl.apply_tangent_factor(x, y); });
+                                  [&](Vec x, Vec y, bool refined) { return nl.apply_tangent_factor(x, y, refined); });
       j["alpha"] = r.alpha;
       j["estimate_ok"] = e.ok;
       j["est_rel_l2"] = e.rel_l2;
@@ -163,6 +163,7 @@ void run_shape(const config::DatasetConfig& cfg, const factory::ShapeSample& sha
       j["est_raw_max_u"] = e.raw_max_u;
       j["est_slope"] = e.slope;
       j["estimate_newton_converged"] = e.newton_steps_converged;
+      j["estimate_krylov_budget_spent"] = e.krylov_budget_spent;
       j["estimate_tangent_assemblies"] = e.tangent_assemblies;
       j["estimate_residual_assemblies"] = e.residual_assemblies;
       std::vector<std::vector<double>> u;

@@ -55,6 +55,13 @@ TEST_CASE("The single-precision LDL^T solves to double precision and counts MUMP
     const double res = relative_residual(S, p.load(), x);
     INFO("relative residual " << res);
     CHECK(res <= 1e-10);
+    // Inside a preconditioner: one single-precision solve, not refined.
+    core::VecH z = p.create_vector();
+    REQUIRE(single.precondition(p.load(), z));
+    const double res_pc = relative_residual(S, p.load(), z);
+    INFO("unrefined relative residual " << res_pc);
+    CHECK(res_pc < 1e-2);  // 1.6e-3 on the indefinite shift (condition ~1e5)
+    CHECK(res_pc > 1e-12);  // not refined to double
     // Against MUMPS in double on the same matrix.
     core::KSPH dbl;
     HS_PETSC(KSPCreate(PETSC_COMM_WORLD, dbl.out()));

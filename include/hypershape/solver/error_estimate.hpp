@@ -5,7 +5,7 @@
 /// scene on the uniformly refined mesh (mesh::refine_uniform, same degree), and one Newton step
 /// of the fine problem is taken from there at the same load:
 ///   K_f(P u_h) e = -R_f(P u_h),
-/// solved by GMRES with a two-grid preconditioner (PCMG: a factor of the coarse tangent as the
+/// solved by GMRES (at most 40 iterations) with a two-grid preconditioner (PCMG: a factor of the coarse tangent as the
 /// coarse level -- the one the nonlinear solve left, or K_c(u_h) factorised here --, P as the
 /// interpolation, symmetric Gauss-Seidel smoothing on the fine level; a few iterations, no
 /// fine factorisation). P u_h + e is the fine solution
@@ -43,6 +43,7 @@ struct ErrorEstimate {
   double raw_max_u = 0;      ///< max_u with theta = 1
   double slope = 0;          ///< dmax|u| / dalpha used for the alpha estimate
   int krylov_iterations = 0;
+  bool krylov_budget_spent = false;  ///< a fine step stopped at the Krylov budget (its iterate kept)
   bool newton_steps_converged = false;  ///< one full Newton step, or steps to 1% of the first residual
   int residual_assemblies = 0, tangent_assemblies = 0, factorizations = 0;
   double seconds = 0;
@@ -55,7 +56,9 @@ double l2_norm_squared(int dim, int degree, const std::vector<double>& coords,
                        const std::vector<std::int64_t>& cells, const std::vector<double>& field, int n_comp);
 
 /// y = K_c^-1 x with a factor of the coarse tangent at (or next to) u_h; false on failure.
-using CoarseSolve = std::function<bool(Vec x, Vec y)>;
+/// `refined` false: the two-grid preconditioner's coarse level, where a single-precision factor's
+/// own solve is enough (NonlinearSolver::apply_tangent_factor).
+using CoarseSolve = std::function<bool(Vec x, Vec y, bool refined)>;
 
 class TwoLevelEstimator {
  public:
@@ -94,7 +97,7 @@ class TwoLevelEstimator {
   /// state), or 0. Energy evaluations counted in out.seconds_assembly.
   double energy_search(Vec x, Vec dx, double alpha, Vec w, ErrorEstimate& out) const;
   /// The coarse level: y = K_c^-1 x by `coarse_` (the caller's factor) or by `direct_`.
-  void coarse_apply(Vec x, Vec y) const;
+  void coarse_apply(Vec x, Vec y, bool refined) const;
   static PetscErrorCode apply_coarse(PC pc, Vec x, Vec y);
   /// Sets up the coarse solve of one estimate (the caller's factor, or K_c(u_h) factorised).
   bool prepare_coarse(Vec u_h, const CoarseSolve& coarse_solve, ErrorEstimate& out) const;

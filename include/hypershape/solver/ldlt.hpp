@@ -60,6 +60,8 @@ class LdltFactor {
   bool factorise(Mat A);
   /// x = A^-1 b for the A last factorised. False if the solve failed. Collective.
   bool solve(Vec b, Vec x);
+  /// x ~ A^-1 b inside a preconditioner: the single kind's unrefined solve, the others' solve.
+  bool precondition(Vec b, Vec x) { return single_ ? single_->solve_unrefined(b, x) : solve(b, x); }
   /// Negative eigenvalues of the A last factorised; -1 unknown. Collective.
   int negative_eigenvalues() const;
   bool factored() const { return factored_; }

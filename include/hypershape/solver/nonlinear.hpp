@@ -161,8 +161,9 @@ class NonlinearSolver {
   /// y = F^-1 x with the tangent factor the last solve left in use (of the tangent at, or one
   /// Newton step before, its final state). False where none exists (the multigrid linear
   /// solver; no path followed yet: solve() runs on the SNES's own solver) or the solve fails. The labels' error estimate uses it as its coarse solve.
+  /// `refined` false: inside a preconditioner (a single-precision factor's solve not refined).
   /// Collective.
-  bool apply_tangent_factor(Vec x, Vec y);
+  bool apply_tangent_factor(Vec x, Vec y, bool refined = true);
 
   SNES snes() const { return snes_.get(); }
   Mat jacobian_matrix() const { return J_.get(); }

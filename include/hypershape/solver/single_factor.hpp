@@ -36,6 +36,10 @@ class SingleFactor {
   /// x = A^-1 b to a relative residual of 1e-10 (or the best GMRES found in 30 iterations: the
   /// Newton iteration judges). False on a non-finite result or without a factor.
   bool solve(Vec b, Vec x);
+  /// x = F^-1 b: one single-precision solve, not refined (relative error ~1e-7 times the
+  /// condition number), for use inside a preconditioner. False on a non-finite result or without
+  /// a factor.
+  bool solve_unrefined(Vec b, Vec x);
   /// Negative eigenvalues of the A last factorised (negative pivots); -1 without a factor.
   int negative_eigenvalues() const { return factored_ ? negative_ : -1; }
   bool factored() const { return factored_; }

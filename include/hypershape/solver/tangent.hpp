@@ -106,7 +106,7 @@ class Tangent {
   /// factorisation and a direct solve. False if no solve succeeded. Collective.
   bool solve(Vec b, Vec x, bool guess);
   /// Applies the inverse of the factor in use: y = F^-1 x (no Krylov). Collective.
-  bool apply_factor(Vec x, Vec y);
+  bool apply_factor(Vec x, Vec y, bool refined = true);
   /// Inertia of the factor in use; -1 unknown. Exact for K(u) only if factor_is_current().
   /// Non-symmetric K (LU): the negative eigenvalues of (K + K^T)/2 when the factor in use is of
   /// the assembled K (its LDL^T made on the first call after the factorisation), else -1. The path
