@@ -20,7 +20,9 @@ LabelErrorEstimator::LabelErrorEstimator(MPI_Comm group, const config::DatasetCo
   fine_shape_.dirichlet_radius = shape.dirichlet_radius;
   fine_shape_.mesh = refined_.mesh;
   fine_ = make_shape_problem(group, cfg, fine_shape_, first, physics::SpaceOptions{coarse.space().degree()});
-  estimator_ = std::make_unique<solver::TwoLevelEstimator>(coarse, *fine_.problem, refined_);
+  // The mean-dilatation element: Newton to tolerance on the fine mesh (TwoLevelEstimator).
+  estimator_ = std::make_unique<solver::TwoLevelEstimator>(coarse, *fine_.problem, refined_,
+                                                           cfg.material.dilatation == "mean");
 }
 
 solver::ErrorEstimate LabelErrorEstimator::estimate(const config::DatasetConfig& cfg, const LoadCase& lc, Vec u,

@@ -8,7 +8,8 @@
 /// solved by GMRES (at most 40 iterations) with a two-grid preconditioner (PCMG: a factor of the coarse tangent as the
 /// coarse level -- the one the nonlinear solve left, or K_c(u_h) factorised here --, P as the
 /// interpolation, symmetric Gauss-Seidel smoothing on the fine level; a few iterations, no
-/// fine factorisation). P u_h + e is the fine solution
+/// fine factorisation; Newton on to 1% of the first residual where the estimator is asked to,
+/// as the factory does for the mean-dilatation element). P u_h + e is the fine solution
 /// u_{h/2} to second order, so e estimates u_{h/2} - u_h, and
 ///   u - u_h ~ theta e,   theta = 1 / (1 - 2^-q)
 /// for an error falling like h^q (q: -error_estimate_order, default 1: the order measured for
@@ -66,7 +67,11 @@ class TwoLevelEstimator {
   /// coarse mesh is the one `coarse` was built from. Builds P. Collective over the problems'
   /// communicator (the same for both). The linear solve reads PETSc options with prefix
   /// "error_estimate_" (-error_estimate_ksp_rtol, -error_estimate_mg_levels_ksp_max_it, ...).
-  TwoLevelEstimator(const physics::Problem& coarse, const physics::Problem& fine, const mesh::RefinedMesh& refined);
+  /// `newton_to_tolerance`: Newton on the fine problem to 1% of its first residual (at most 4
+  /// steps) even when the first step is a full one (the mean-dilatation element's estimates
+  /// need it); otherwise one full step is the estimate.
+  TwoLevelEstimator(const physics::Problem& coarse, const physics::Problem& fine, const mesh::RefinedMesh& refined,
+                    bool newton_to_tolerance = false);
   ~TwoLevelEstimator();
   TwoLevelEstimator(const TwoLevelEstimator&) = delete;
   TwoLevelEstimator& operator=(const TwoLevelEstimator&) = delete;
@@ -103,6 +108,7 @@ class TwoLevelEstimator {
   bool prepare_coarse(Vec u_h, const CoarseSolve& coarse_solve, ErrorEstimate& out) const;
   const physics::Problem& coarse_;
   const physics::Problem& fine_;
+  bool newton_to_tolerance_ = false;
   /// Prolongation in canonical numbering (every rank): fine node i = sum_k w[k] coarse node
   /// col[k], k in [row[i], row[i+1]).
   std::vector<std::int64_t> row_, col_;
