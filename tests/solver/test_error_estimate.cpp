@@ -41,6 +41,17 @@ Pair make_pair(const mesh::MeshData& m, int degree, const EffectsMaker& effects)
   return p;
 }
 
+/// The unit square clamped at x = 0 under a Gaussian downward traction on y = 1 (nu 0.45).
+std::vector<physics::EffectPtr> clamped_box_effects() {
+  std::vector<physics::EffectPtr> e;
+  e.push_back(physics::make_neo_hookean(500, 0.45));
+  e.push_back(physics::make_dirichlet("clamp", hstest::on_plane(0, 0.0), {0, 1}));
+  e.push_back(physics::make_surface_traction(
+      [](const double* x, double* t) { t[0] = 0, t[1] = -std::exp(-20 * (x[0] - 0.8) * (x[0] - 0.8)); },
+      hstest::on_plane(1, 1.0)));
+  return e;
+}
+
 /// u* of test_mms (2D): (0.12 sin(pi x) sin(pi y), 0.06 sin(2 pi x) sin(pi y)) and its body force
 /// for the Neo-Hookean material (E 500, nu 0.3).
 struct Mms {
@@ -194,15 +205,7 @@ TEST_CASE("The estimate on the solver's factor is the estimate on its own", "[er
   // The factory passes the nonlinear solver's factor as the coarse level (a tangent one Newton
   // step before u_h); the estimator's own factorisation of K_c(u_h) must give the same estimate
   // up to the fine solve's tolerance, and without a factor the estimate says so (ok = false).
-  auto effects = [] {
-    std::vector<physics::EffectPtr> e;
-    e.push_back(physics::make_neo_hookean(500, 0.45));
-    e.push_back(physics::make_dirichlet("clamp", hstest::on_plane(0, 0.0), {0, 1}));
-    e.push_back(physics::make_surface_traction(
-        [](const double* x, double* t) { t[0] = 0, t[1] = -std::exp(-20 * (x[0] - 0.8) * (x[0] - 0.8)); },
-        hstest::on_plane(1, 1.0)));
-    return e;
-  };
+  const EffectsMaker effects = clamped_box_effects;
   Pair p = make_pair(mesh::mesh_box(2, 1.0, 0.125), 1, effects);
   solver::NonlinearSolver fresh(*p.coarse, solver::SolverOptions{});
   Vec x = p.coarse->load();
@@ -231,15 +234,7 @@ TEST_CASE("Newton to tolerance on the fine mesh takes the steps one full step sk
   // The mean-dilatation datasets ask for it (LabelErrorEstimator): there the first step mostly
   // restores the fine cells' volumes. On a smooth case both agree; the test is that the steps
   // are taken (a residual to 1% of the first) and that they stay at the same estimate.
-  auto effects = [] {
-    std::vector<physics::EffectPtr> e;
-    e.push_back(physics::make_neo_hookean(500, 0.45));
-    e.push_back(physics::make_dirichlet("clamp", hstest::on_plane(0, 0.0), {0, 1}));
-    e.push_back(physics::make_surface_traction(
-        [](const double* x, double* t) { t[0] = 0, t[1] = -std::exp(-20 * (x[0] - 0.8) * (x[0] - 0.8)); },
-        hstest::on_plane(1, 1.0)));
-    return e;
-  };
+  const EffectsMaker effects = clamped_box_effects;
   Pair p = make_pair(mesh::mesh_box(2, 1.0, 0.125), 2, effects);
   solver::TwoLevelEstimator to_tolerance(*p.coarse, *p.fine, p.refined, true);
   solver::NonlinearSolver ns(*p.coarse, solver::SolverOptions{});
@@ -261,15 +256,7 @@ TEST_CASE("A fine step that spends its Krylov budget is kept", "[error_estimate]
   // (docs/ACCURACY.md); GMRES's iterate is kept there, judged by the energy line search. Here a
   // budget of one iteration (the converged step takes more): an estimate all the same, flagged,
   // within a factor of the converged one.
-  auto effects = [] {
-    std::vector<physics::EffectPtr> e;
-    e.push_back(physics::make_neo_hookean(500, 0.45));
-    e.push_back(physics::make_dirichlet("clamp", hstest::on_plane(0, 0.0), {0, 1}));
-    e.push_back(physics::make_surface_traction(
-        [](const double* x, double* t) { t[0] = 0, t[1] = -std::exp(-20 * (x[0] - 0.8) * (x[0] - 0.8)); },
-        hstest::on_plane(1, 1.0)));
-    return e;
-  };
+  const EffectsMaker effects = clamped_box_effects;
   const auto m = mesh::mesh_box(2, 1.0, 0.125);
   Pair full = make_pair(m, 2, effects);
   solver::NonlinearSolver ns(*full.coarse, solver::SolverOptions{});
