@@ -159,7 +159,7 @@ bool Problem::energy_along(Vec from, Vec to, double load_factor, double& value) 
   return true;
 }
 
-bool Problem::energy(Vec u, double load_factor, double& value) const {
+bool Problem::energy(Vec u, double load_factor, double& value, double* internal) const {
   LocalArray ul(dm(), false);
   to_local(u, ul.vec());
   double e = 0;
@@ -168,11 +168,16 @@ bool Problem::energy(Vec u, double load_factor, double& value) const {
     if (eff->has_energy()) ok = ok && eff->add_energy(*space_, ul.array(), e);
   ok = all_ranks(comm(), ok);
   MPI_Allreduce(MPI_IN_PLACE, &e, 1, MPI_DOUBLE, MPI_SUM, comm());
+  if (internal) *internal = e;
+  value = ok ? energy_from_internal(u, load_factor, e) : INFINITY;
+  return ok;
+}
+
+double Problem::energy_from_internal(Vec u, double load_factor, double internal) const {
   PetscScalar work, fixed = 0;
   HS_PETSC(VecDot(load_, u, &work));
   if (fixed_load_) HS_PETSC(VecDot(fixed_load_, u, &fixed));
-  value = ok ? e - load_factor * PetscRealPart(work) - PetscRealPart(fixed) : INFINITY;
-  return ok;
+  return internal - load_factor * PetscRealPart(work) - PetscRealPart(fixed);
 }
 
 bool Problem::residual(Vec u, double load_factor, Vec r) const {
@@ -183,12 +188,34 @@ bool Problem::residual(Vec u, double load_factor, Vec r) const {
     if (eff->has_energy()) ok = ok && eff->add_residual(*space_, ul.array(), rl.array());
   if (has_follower_) add_follower_loads(ul.array(), load_factor, rl.array());
   ok = all_ranks(comm(), ok);
+  finish_residual(rl, load_factor, r);
+  return ok;
+}
+
+bool Problem::energy_residual(Vec u, double load_factor, double& value, Vec r, double* internal) const {
+  if (has_follower_) {  // energy_along's merit function, not this energy
+    throw std::logic_error("Problem::energy_residual: a follower load has no energy");
+  }
+  LocalArray ul(dm(), false), rl(dm(), true);
+  to_local(u, ul.vec());
+  double e = 0;
+  bool ok = true;
+  for (auto& eff : effects_)
+    if (eff->has_energy()) ok = ok && eff->add_energy_residual(*space_, ul.array(), e, rl.array());
+  ok = all_ranks(comm(), ok);
+  MPI_Allreduce(MPI_IN_PLACE, &e, 1, MPI_DOUBLE, MPI_SUM, comm());
+  if (internal) *internal = e;
+  value = ok ? energy_from_internal(u, load_factor, e) : INFINITY;
+  if (ok) finish_residual(rl, load_factor, r);
+  return ok;
+}
+
+void Problem::finish_residual(LocalArray& rl, double load_factor, Vec r) const {
   rl.release();
   HS_PETSC(VecZeroEntries(r));
   HS_PETSC(DMLocalToGlobal(dm(), rl.vec(), ADD_VALUES, r));
   if (load_factor != 0.0) HS_PETSC(VecAXPY(r, -load_factor, load_));
   if (fixed_load_) HS_PETSC(VecAXPY(r, -1.0, fixed_load_));
-  return ok;
 }
 
 bool Problem::jacobian(Vec u, Mat J, double load_factor) const {

@@ -141,7 +141,7 @@ bool NonlinearSolver::minimise(double s, double eps, int& its, std::string& why)
       radius = 0.25 * std::min(radius, double(ymax));
       continue;
     }
-    HS_PETSC(VecCopy(w_, u_));
+    accept_trial(w_, u_);
     // Grow the region after a full step that filled it, shrink it to what the line search took.
     if (lambda == 1.0 && ymax >= 0.99 * radius) radius = std::min(2 * radius, 20 * eps);
     else if (lambda < 1.0) radius = std::max(lambda * ymax, 1e-3 * eps);

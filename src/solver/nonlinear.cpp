@@ -82,6 +82,7 @@ NonlinearSolver::NonlinearSolver(const physics::Problem& problem, const SolverOp
 void NonlinearSolver::reset() {
   HS_PETSC(VecZeroEntries(u_));
   s_ = 0;
+  known_internal_ = NAN;
 }
 
 PetscErrorCode NonlinearSolver::form_function(SNES snes, Vec x, Vec f, void* ctx) {
@@ -122,7 +123,7 @@ void NonlinearSolver::line_search(SNESLineSearch ls) {
     HS_PETSC(SNESLineSearchSetReason(ls, SNES_LINESEARCH_FAILED_REDUCT));
     return;
   }
-  HS_PETSC(VecCopy(W, X));
+  accept_trial(W, X);
   HS_PETSC(VecCopy(G, F));
   HS_PETSC(SNESLineSearchSetLambda(ls, lambda));
   HS_PETSC(SNESLineSearchComputeNorms(ls));
@@ -138,18 +139,20 @@ double NonlinearSolver::backtrack(Vec X, Vec Y, Vec F, double s, Vec W, Vec G) {
   HS_PETSC(VecNorm(F, NORM_2, &fnorm0));
   HS_PETSC(VecDot(F, Y, &slope));
   slope = -slope;  // d/dlambda of the energy at lambda = 0
-  double e0;
-  problem_.energy(X, s, e0);
+  const double e0 = energy_at_start(X, s);
   constexpr double c = 1e-4;
   double lambda = 1.0;
   for (int it = 0; it < 40 && lambda > 1e-10; ++it) {
     HS_PETSC(VecWAXPY(W, -lambda, Y, X));
     double e;
-    if (!problem_.energy_along(X, W, s, e)) {  // inadmissible: never accept, halve
+    trial_internal_ = NAN;
+    const bool admissible = problem_.conservative() ? problem_.energy_residual(W, s, e, G, &trial_internal_)
+                                                    : problem_.energy_along(X, W, s, e);
+    if (!admissible) {  // inadmissible: never accept, halve
       lambda *= 0.5;
       continue;
     }
-    const bool ok = problem_.residual(W, s, G);
+    const bool ok = problem_.conservative() || problem_.residual(W, s, G);
     if (ok && slope < 0 && e <= e0 + c * lambda * slope) return lambda;
     PetscReal gnorm;
     HS_PETSC(VecNorm(G, NORM_2, &gnorm));
@@ -165,9 +168,27 @@ double NonlinearSolver::backtrack(Vec X, Vec Y, Vec F, double s, Vec W, Vec G) {
   return 0.0;
 }
 
+void NonlinearSolver::accept_trial(Vec W, Vec X) {
+  HS_PETSC(VecCopy(W, X));
+  known_internal_ = trial_internal_;
+  if (std::isnan(known_internal_)) return;
+  if (!known_state_) HS_PETSC(VecDuplicate(X, known_state_.out()));
+  HS_PETSC(VecCopy(X, known_state_));
+}
+
+double NonlinearSolver::energy_at_start(Vec X, double s) {
+  PetscBool same = PETSC_FALSE;
+  if (!std::isnan(known_internal_)) HS_PETSC(VecEqual(X, known_state_, &same));
+  if (same) return problem_.energy_from_internal(X, s, known_internal_);
+  double e;
+  problem_.energy(X, s, e);
+  return e;
+}
+
 TargetResult NonlinearSolver::solve_for_target(double target) {
   const double start = core::now_seconds();
   const LinearCounters linear_before = linear_counters();
+  known_internal_ = NAN;  // the problem may have changed since (effects switched, a new load)
   TargetResult t = opt_.control == Control::displacement ? follow_path(target, start)
                                                           : search_target(target, start);
   // (t.solves == 0: the path never started, e.g. no tangent at the initial state: no branch.)

@@ -227,7 +227,7 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
             " negative pivot(s))";
       return false;
     }
-    HS_PETSC(VecCopy(w_, u_));
+    accept_trial(w_, u_);
     s_ += lambda * dalpha;
     HS_PETSC(VecWAXPY(r_, (1.0 - lambda) * dalpha, problem_.load_at(u_), b_));  // R(w, s_)
     HS_PETSC(VecNorm(r_, NORM_2, &rn));
@@ -300,7 +300,7 @@ bool NonlinearSolver::predict(double d_next, std::string& why) {
   HS_PETSC(VecAXPBY(du_, -dalpha, 0.0, a_));  // Y = -dalpha a
   const double lambda = backtrack(u_, du_, r_, s_pred, w_, b_);
   if (lambda > 0.0) {
-    HS_PETSC(VecCopy(w_, u_));
+    accept_trial(w_, u_);
     s_ += lambda * dalpha;
   }
   return true;

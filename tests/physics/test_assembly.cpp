@@ -18,10 +18,12 @@ struct Case {
 };
 
 /// A small problem: the clamped disk with a Gaussian traction in 2D, a cube clamped on x = 0
-/// with a Gaussian traction near the opposite corner in 3D.
-std::unique_ptr<physics::Problem> make_problem(int dim, int degree) {
+/// with a Gaussian traction near the opposite corner in 3D; the Neo-Hookean pointwise or on the
+/// cells' mean dilatation.
+std::unique_ptr<physics::Problem> make_problem(int dim, int degree, bool mean_dilatation = false) {
   std::vector<physics::EffectPtr> effects;
-  effects.push_back(physics::make_neo_hookean(500.0, 0.3));
+  effects.push_back(mean_dilatation ? physics::make_neo_hookean_mean_dilatation(500.0, 0.3)
+                                    : physics::make_neo_hookean(500.0, 0.3));
   mesh::MeshData m;
   if (dim == 2) {
     m = hstest::disk_mesh(0.2);
@@ -119,6 +121,44 @@ TEST_CASE("Re-assembly straight into the CSR values equals PETSc's assembly", "[
       check_equals_pointwise(*p, u, J);
     }
   }
+}
+
+TEST_CASE("Energy and residual in one pass equal the two passes bit for bit", "[assembly]") {
+  // A line search's trial takes both from Problem::energy_residual; the solver's data must not
+  // depend on it. Both materials (pointwise and mean dilatation), every element.
+  for (const Case& c : cases)
+    for (const bool mean : {false, true}) {
+      DYNAMIC_SECTION(c.name << (mean ? ", mean dilatation" : "")) {
+        auto p = make_problem(c.dim, c.degree, mean);
+        const int dim = c.dim;
+        core::VecH u = p->create_vector(), r = p->create_vector(), r1 = p->create_vector();
+        hstest::interpolate(
+            *p, [dim](const double* x, double* v) { smooth_field(x, v, dim, 1.0); }, u);
+        const double s = 3.7;
+        double e = 0, e1 = 0, internal = 0;
+        REQUIRE(p->energy(u, s, e));
+        REQUIRE(p->residual(u, s, r));
+        REQUIRE(p->energy_residual(u, s, e1, r1, &internal));
+        REQUIRE(std::isfinite(e));
+        CHECK(e1 == e);
+        PetscBool same = PETSC_FALSE;
+        HS_PETSC(VecEqual(r, r1, &same));
+        CHECK(same);
+        // The stored part and the loads' work give the same energy at any load factor.
+        double e2;
+        REQUIRE(p->energy(u, -1.25, e2));
+        CHECK(p->energy_from_internal(u, -1.25, internal) == e2);
+        CHECK(e2 != e);
+        // Inadmissible (inverted) states: false, the residual left as it was.
+        HS_PETSC(VecScale(u, 40.0));
+        REQUIRE_FALSE(p->energy(u, s, e));
+        HS_PETSC(VecCopy(r, r1));
+        CHECK_FALSE(p->energy_residual(u, s, e1, r1));
+        CHECK(std::isinf(e1));
+        HS_PETSC(VecEqual(r, r1, &same));
+        CHECK(same);
+      }
+    }
 }
 
 TEST_CASE("The residual is the gradient of the potential energy", "[assembly]") {

@@ -55,6 +55,11 @@ class Effect {
   virtual bool add_jacobian(const Space&, const PetscScalar* /*u*/, Mat /*J*/) const {
     return true;
   }
+  /// add_energy and add_residual in one pass (a line search's trial needs both): the same sums
+  /// in the same order; a material overrides it to share the kinematics of its cells.
+  virtual bool add_energy_residual(const Space& s, const PetscScalar* u, double& energy, PetscScalar* r) const {
+    return add_energy(s, u, energy) && add_residual(s, u, r);
+  }
   /// Registers the same physics as PETSc pointwise functions (generic assembly, cross-checks).
   virtual void set_pointwise(PetscDS /*ds*/) const {}
 

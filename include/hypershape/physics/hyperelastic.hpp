@@ -83,6 +83,14 @@ void g3_pointwise(PetscInt dim, PetscInt, PetscInt, const PetscInt[], const Pets
   if (dim == 2) run.template operator()<2>(); else run.template operator()<3>();
 }
 
+/// W(F) and P(F) of kernel K at once: its energy_stress where it has one (sharing det F and
+/// ln J), else energy then stress. The same numbers either way.
+template <class K, class T>
+bool energy_stress(const K& k, const T& F, double& W, T& P) {
+  if constexpr (requires { k.energy_stress(F, W, P); }) return k.energy_stress(F, W, P);
+  else return k.energy(F, W) && k.stress(F, P);
+}
+
 /// Runs `op.operator()<D, NB>()` for the space's dimension D and nodes per cell NB.
 template <class Op>
 bool dispatch(const Space& s, Op&& op) {
@@ -171,6 +179,32 @@ class HyperelasticEffect : public Effect {
           const Tensor<D> F = Tensor<D>::Identity() + ue.transpose() * G;
           if (!k.stress(F, P)) return false;
           re.noalias() += weight(s, c, q, dj) * (G * P.transpose());  // r_ai = sum_J P_iJ G_aJ
+        }
+        const PetscInt* idx = s.local_dofs(c);
+        for (int a = 0; a < NB; ++a)
+          for (int i = 0; i < D; ++i) r[idx[a * D + i]] += re(a, i);
+      }
+      return true;
+    });
+  }
+
+  bool add_energy_residual(const Space& s, const PetscScalar* u, double& energy, PetscScalar* r) const override {
+    return detail::dispatch(s, [&]<int D, int NB>() {
+      const auto& k = kernel<D>();
+      Eigen::Matrix<double, NB, D> ue, G, re;
+      Tensor<D> P;
+      for (PetscInt c = s.cell_begin(); c < s.cell_end(); ++c) {
+        detail::gather<D, NB>(s, c, u, ue);
+        const double dj = s.det_jacobian(c);
+        re.setZero();
+        for (int q = 0; q < s.n_qp(); ++q) {
+          detail::physical_gradients<D, NB>(s, c, q, G);
+          const Tensor<D> F = Tensor<D>::Identity() + ue.transpose() * G;
+          double W;
+          if (!detail::energy_stress(k, F, W, P)) return false;
+          const double w = weight(s, c, q, dj);
+          energy += w * W;
+          re.noalias() += w * (G * P.transpose());
         }
         const PetscInt* idx = s.local_dofs(c);
         for (int a = 0; a < NB; ++a)

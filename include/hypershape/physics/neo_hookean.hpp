@@ -38,6 +38,17 @@ struct NeoHookean {
     return true;
   }
 
+  /// energy() and stress() at once (det F, F^-1 and ln J computed once): the same numbers.
+  bool energy_stress(const Tensor<D>& F, double& W, Tensor<D>& P) const {
+    const double J = F.determinant();
+    if (!(J > 0)) return false;
+    const double lnJ = std::log(J);
+    W = 0.5 * mu * (F.squaredNorm() - D - 2.0 * lnJ) + 0.5 * lambda * lnJ * lnJ;
+    const Tensor<D> FinvT = F.inverse().transpose();
+    P = mu * (F - FinvT) + (lambda * lnJ) * FinvT;
+    return true;
+  }
+
   bool stress_tangent(const Tensor<D>& F, Tensor<D>& P, Tangent<D>& A) const {
     const double J = F.determinant();
     if (!(J > 0)) return false;

@@ -17,6 +17,10 @@
 #include "hypershape/physics/effect.hpp"
 #include "hypershape/physics/space.hpp"
 
+namespace hypershape::core {
+class LocalArray;
+}
+
 namespace hypershape::physics {
 
 /// Nodal values gathered on rank 0 in canonical node order (vertices of the input mesh first,
@@ -88,7 +92,12 @@ class Problem {
   void replace_load(std::size_t index, EffectPtr effect);
 
   /// Each returns false (on every rank) if u has det F <= 0 at some quadrature point. Collective.
-  bool energy(Vec u, double load_factor, double& value) const;
+  /// `internal` (if given): the stored energy alone, the part energy_from_internal adds the
+  /// loads' work to.
+  bool energy(Vec u, double load_factor, double& value, double* internal = nullptr) const;
+  /// The energy at u from its stored part `internal` (as energy() returned it at this u): the
+  /// same number, without the cells. Collective.
+  double energy_from_internal(Vec u, double load_factor, double internal) const;
   /// A merit function on the segment from `from` to `to` for line searches: energy(to) when the
   /// problem is conservative; with a follower load (no energy), the conservative part's energy at
   /// `to` minus the follower loads' work along the segment, int_0^1 f(from + t d) . d dt, d = to -
@@ -96,6 +105,9 @@ class Problem {
   /// derivative along the segment is R . d, as the energy's is. False if `to` is inadmissible.
   bool energy_along(Vec from, Vec to, double load_factor, double& value) const;
   bool residual(Vec u, double load_factor, Vec r) const;
+  /// energy() and residual() in one pass over the cells (a line search's trial): the same
+  /// numbers; `r` is left untouched where u is inadmissible. Not with a follower load.
+  bool energy_residual(Vec u, double load_factor, double& value, Vec r, double* internal = nullptr) const;
   /// `load_factor` matters only for a scaled follower load (its load stiffness is s df_s/du).
   bool jacobian(Vec u, Mat J, double load_factor = 0.0) const;
   /// The same residual (load factor 0) and tangent through PETSc's generic pointwise assembly
@@ -121,6 +133,8 @@ class Problem {
  private:
   /// Global -> local with the essential values inserted.
   void to_local(Vec u, Vec ul) const;
+  /// The global residual from the local array of the cells' sums: minus the loads.
+  void finish_residual(core::LocalArray& rl, double load_factor, Vec r) const;
   void assemble_load();
   /// Assembles the loads of the effects with scaled() == `scaled` into `f` (global).
   void assemble_loads(bool scaled, Vec f) const;

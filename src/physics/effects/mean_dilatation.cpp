@@ -64,20 +64,19 @@ class MeanDilatationNeoHookean : public Effect {
 
   bool add_energy(const Space& s, const PetscScalar* u, double& energy) const override {
     if (!shear_.add_energy(s, u, energy)) return false;
-    return for_cells<false>(s, u, [&](PetscInt c, const auto& cell) {
-      const double ln = std::log(cell.theta());
-      energy += 0.5 * lambda(s, c) * cell.V * ln * ln;
-    });
+    return for_cells<false>(s, u, [&](PetscInt c, const auto& cell) { add_volumetric_energy(s, c, cell, energy); });
   }
 
   bool add_residual(const Space& s, const PetscScalar* u, PetscScalar* r) const override {
     if (!shear_.add_residual(s, u, r)) return false;
+    return for_cells<false>(s, u, [&](PetscInt c, const auto& cell) { add_volumetric_residual(s, c, cell, r); });
+  }
+
+  bool add_energy_residual(const Space& s, const PetscScalar* u, double& energy, PetscScalar* r) const override {
+    if (!shear_.add_energy_residual(s, u, energy, r)) return false;
     return for_cells<false>(s, u, [&](PetscInt c, const auto& cell) {
-      const double theta = cell.theta();
-      const double dU = lambda(s, c) * std::log(theta) / theta;
-      const PetscInt* idx = s.local_dofs(c);
-      for (int a = 0; a < cell.g.rows(); ++a)
-        for (int i = 0; i < cell.g.cols(); ++i) r[idx[a * cell.g.cols() + i]] += dU * cell.g(a, i);
+      add_volumetric_energy(s, c, cell, energy);
+      add_volumetric_residual(s, c, cell, r);
     });
   }
 
@@ -104,6 +103,22 @@ class MeanDilatationNeoHookean : public Effect {
     Eigen::Matrix<double, NB * D, NB * D, Eigen::RowMajor> H;
     double theta() const { return v / V; }
   };
+
+  /// Cell c's V_e lambda/2 (ln theta_e)^2 into `energy`.
+  template <class C>
+  void add_volumetric_energy(const Space& s, PetscInt c, const C& cell, double& energy) const {
+    const double ln = std::log(cell.theta());
+    energy += 0.5 * lambda(s, c) * cell.V * ln * ln;
+  }
+  /// Cell c's U'(theta_e) g into the local residual array `r`.
+  template <class C>
+  void add_volumetric_residual(const Space& s, PetscInt c, const C& cell, PetscScalar* r) const {
+    const double theta = cell.theta();
+    const double dU = lambda(s, c) * std::log(theta) / theta;
+    const PetscInt* idx = s.local_dofs(c);
+    for (int a = 0; a < cell.g.rows(); ++a)
+      for (int i = 0; i < cell.g.cols(); ++i) r[idx[a * cell.g.cols() + i]] += dU * cell.g(a, i);
+  }
 
   /// Runs op(c, cell) for each local cell with v, V, g (and H when `hessian`); false if some
   /// quadrature point has det F <= 0.
