@@ -4,8 +4,11 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <tuple>
+#include <utility>
 
 #include "hypershape/core/error.hpp"
 #include "hypershape/core/vec_array.hpp"
@@ -201,14 +204,19 @@ void LdltFactor::build_block_pattern(Mat A, const std::vector<PetscInt>& new_blo
   const PetscInt *fi, *fj;
   PetscInt nfr;
   HS_PETSC(MatGetRowIJ(F_, 0, PETSC_FALSE, PETSC_TRUE, &nfr, &fi, &fj, &done));
-  value_map_.assign(std::size_t(ia[n]), -1);
+  if (std::int64_t(ia[n]) > std::int64_t(UINT32_MAX)) throw std::logic_error("blocked LDL^T: more nonzeros than 32-bit offsets hold");
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> to_from;  // (position in F_, in A)
   for (PetscInt i = 0; i < n; ++i)
     for (PetscInt k = ia[i]; k < ia[i + 1]; ++k) {
       const PetscInt bi = new_block[std::size_t(i / 2)], bj = new_block[std::size_t(ja[k] / 2)];
       if (bi > bj) continue;
       const PetscInt q = PetscInt(std::lower_bound(fj + fi[bi], fj + fi[bi + 1], bj) - fj);
-      value_map_[std::size_t(k)] = 4 * q + 2 * (ja[k] % 2) + i % 2;  // blocks are column-major
+      to_from.emplace_back(std::uint32_t(4 * q + 2 * (ja[k] % 2) + i % 2), std::uint32_t(k));  // blocks are column-major
     }
+  std::sort(to_from.begin(), to_from.end());
+  source_.resize(to_from.size());
+  target_.resize(to_from.size());
+  for (std::size_t k = 0; k < to_from.size(); ++k) std::tie(target_[k], source_[k]) = to_from[k];
   HS_PETSC(MatRestoreRowIJ(F_, 0, PETSC_FALSE, PETSC_TRUE, &nfr, &fi, &fj, &done));
   HS_PETSC(MatRestoreRowIJ(A, 0, PETSC_FALSE, PETSC_FALSE, &nr, &ia, &ja, &done));
 }
@@ -218,8 +226,7 @@ void LdltFactor::scatter_values(Mat A) {
   PetscScalar* fv;
   HS_PETSC(MatSeqAIJGetArrayRead(A, &av));
   HS_PETSC(MatSeqSBAIJGetArray(F_, &fv));
-  for (std::size_t k = 0; k < value_map_.size(); ++k)
-    if (value_map_[k] >= 0) fv[value_map_[k]] = av[k];
+  for (std::size_t k = 0; k < target_.size(); ++k) fv[target_[k]] = av[source_[k]];
   HS_PETSC(MatSeqSBAIJRestoreArray(F_, &fv));
   HS_PETSC(MatSeqAIJRestoreArrayRead(A, &av));
   // New values: the next set-up factorises anew (numerically; the pattern is the same).

@@ -26,14 +26,14 @@ namespace detail {
 
 /// Physical basis gradients G (NB x D) of cell c at quadrature point q.
 template <int D, int NB>
-inline void physical_gradients(const Space& s, PetscInt c, int q, Eigen::Matrix<double, NB, D>& G) {
+[[gnu::always_inline]] inline void physical_gradients(const Space& s, PetscInt c, int q, Eigen::Matrix<double, NB, D>& G) {
   Eigen::Map<const Eigen::Matrix<double, NB, D, Eigen::RowMajor>> dref(s.ref_grad(q));
   Eigen::Map<const Eigen::Matrix<double, D, D, Eigen::RowMajor>> iJ(s.inv_jacobian(c));
   G.noalias() = dref * iJ;  // dN/dx_j = sum_k dN/dxi_k dxi_k/dx_j
 }
 
 template <int D, int NB>
-inline void gather(const Space& s, PetscInt c, const PetscScalar* u, Eigen::Matrix<double, NB, D>& ue) {
+[[gnu::always_inline]] inline void gather(const Space& s, PetscInt c, const PetscScalar* u, Eigen::Matrix<double, NB, D>& ue) {
   const PetscInt* idx = s.local_dofs(c);
   for (int a = 0; a < NB; ++a)
     for (int i = 0; i < D; ++i) ue(a, i) = u[idx[a * D + i]];

@@ -21,6 +21,7 @@
 ///    (an LU factor has none): negative_eigenvalues() is -1.
 #include <petscksp.h>
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -74,7 +75,7 @@ class LdltFactor {
   void set_up_blocked(Mat A);
   /// The new block index of each node (old block), and old_of_new_ (scalar).
   std::vector<PetscInt> node_ordering(Mat A);
-  /// F_ with the upper 2x2-block pattern of A in the new ordering, and value_map_.
+  /// F_ with the upper 2x2-block pattern of A in the new ordering, and source_ / target_.
   void build_block_pattern(Mat A, const std::vector<PetscInt>& new_block);
   void scatter_values(Mat A);
   /// Blocked kind: GMRES on F_ preconditioned by the factor where the solve lost digits.
@@ -89,8 +90,9 @@ class LdltFactor {
   core::KSPH ksp_;
   // Blocked kind: old scalar index of new scalar index i = 2 node[i / 2] + i % 2 ...
   std::vector<PetscInt> old_of_new_;
-  /// ... and, per nonzero of A's CSR values, its position in F_'s values (-1: lower triangle).
-  std::vector<PetscInt> value_map_;
+  /// ... and where F_'s values come from: value source_[k] of A's CSR values goes to position
+  /// target_[k] of F_'s (the upper triangle's only; in F_'s order, so the writes stream).
+  std::vector<std::uint32_t> source_, target_;
   core::VecH xp_, yp_, rp_;  ///< b, x and the residual in the new ordering
   core::KSPH refine_;
   std::unique_ptr<SingleFactor> single_;  ///< the single kind (then F_ and ksp_ are unused)
