@@ -8,6 +8,7 @@
 #   scripts/bench_generate.sh [SHAPES] [LOADS] [REPEATS]    (JSON: results/bench_generate.json)
 #   PRESET=random3d scripts/bench_generate.sh 10 20 1       (a Random3D slice of 200 load cases)
 #   SEED=90210 ...                                          (another seed than the preset's)
+#   SHAPES_H=0.12 MESH='{degree: 2}' ...                    (another discretisation: shapes.h, mesh:)
 # Two projections of the full preset: from the slice's rate (its wall time; a small slice ends
 # with one rank idle while the other finishes the last shard), and from its work (phase seconds
 # summed over ranks, spread evenly over the ranks, plus one shard of the full run's size run
@@ -22,10 +23,11 @@ cat > "$work/slice.yaml" <<YAML
 preset: ${PRESET:-random2d}
 name: bench_${PRESET:-random2d}${SEED:+
 seed: $SEED}
-shapes: {count: $shapes}
+shapes: {count: $shapes${SHAPES_H:+, h: $SHAPES_H}}
 loads: {count: $loads}
 output: {shard_size: 2}
 YAML
+if [ -n "${MESH:-}" ]; then echo "mesh: $MESH" >> "$work/slice.yaml"; fi
 for ((k = 0; k < repeats; ++k)); do
   build/hypershape -q generate "$work/slice.yaml" --progress 0 -o "$work/np1-$k"
   mpiexec -n 2 build/hypershape -q generate "$work/slice.yaml" --progress 0 -o "$work/np2-$k"
