@@ -192,7 +192,8 @@ bool Problem::residual(Vec u, double load_factor, Vec r) const {
   return ok;
 }
 
-bool Problem::energy_residual(Vec u, double load_factor, double& value, Vec r, double* internal) const {
+bool Problem::energy_residual(Vec u, double load_factor, double& value, Vec r, double* internal,
+                              Vec internal_force) const {
   if (has_follower_) {  // energy_along's merit function, not this energy
     throw std::logic_error("Problem::energy_residual: a follower load has no energy");
   }
@@ -206,14 +207,24 @@ bool Problem::energy_residual(Vec u, double load_factor, double& value, Vec r, d
   MPI_Allreduce(MPI_IN_PLACE, &e, 1, MPI_DOUBLE, MPI_SUM, comm());
   if (internal) *internal = e;
   value = ok ? energy_from_internal(u, load_factor, e) : INFINITY;
-  if (ok) finish_residual(rl, load_factor, r);
+  if (ok) finish_residual(rl, load_factor, r, internal_force);
   return ok;
 }
 
-void Problem::finish_residual(LocalArray& rl, double load_factor, Vec r) const {
+void Problem::residual_from_internal(Vec internal_force, double load_factor, Vec r) const {
+  HS_PETSC(VecCopy(internal_force, r));
+  subtract_loads(load_factor, r);
+}
+
+void Problem::finish_residual(LocalArray& rl, double load_factor, Vec r, Vec internal_force) const {
   rl.release();
   HS_PETSC(VecZeroEntries(r));
   HS_PETSC(DMLocalToGlobal(dm(), rl.vec(), ADD_VALUES, r));
+  if (internal_force) HS_PETSC(VecCopy(r, internal_force));
+  subtract_loads(load_factor, r);
+}
+
+void Problem::subtract_loads(double load_factor, Vec r) const {
   if (load_factor != 0.0) HS_PETSC(VecAXPY(r, -load_factor, load_));
   if (fixed_load_) HS_PETSC(VecAXPY(r, -1.0, fixed_load_));
 }

@@ -5,6 +5,7 @@
 #include <petscmat.h>
 
 #include <algorithm>
+#include <utility>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -146,8 +147,10 @@ double NonlinearSolver::backtrack(Vec X, Vec Y, Vec F, double s, Vec W, Vec G) {
     HS_PETSC(VecWAXPY(W, -lambda, Y, X));
     double e;
     trial_internal_ = NAN;
-    const bool admissible = problem_.conservative() ? problem_.energy_residual(W, s, e, G, &trial_internal_)
-                                                    : problem_.energy_along(X, W, s, e);
+    if (!trial_force_) HS_PETSC(VecDuplicate(W, trial_force_.out()));
+    const bool admissible = problem_.conservative()
+                                ? problem_.energy_residual(W, s, e, G, &trial_internal_, trial_force_)
+                                : problem_.energy_along(X, W, s, e);
     if (!admissible) {  // inadmissible: never accept, halve
       lambda *= 0.5;
       continue;
@@ -174,15 +177,26 @@ void NonlinearSolver::accept_trial(Vec W, Vec X) {
   if (std::isnan(known_internal_)) return;
   if (!known_state_) HS_PETSC(VecDuplicate(X, known_state_.out()));
   HS_PETSC(VecCopy(X, known_state_));
+  std::swap(known_force_, trial_force_);  // trial_force_ holds W's (the trial evaluated last)
+}
+
+bool NonlinearSolver::is_known_state(Vec X) {
+  PetscBool same = PETSC_FALSE;
+  if (!std::isnan(known_internal_)) HS_PETSC(VecEqual(X, known_state_, &same));
+  return same;
 }
 
 double NonlinearSolver::energy_at_start(Vec X, double s) {
-  PetscBool same = PETSC_FALSE;
-  if (!std::isnan(known_internal_)) HS_PETSC(VecEqual(X, known_state_, &same));
-  if (same) return problem_.energy_from_internal(X, s, known_internal_);
+  if (is_known_state(X)) return problem_.energy_from_internal(X, s, known_internal_);
   double e;
   problem_.energy(X, s, e);
   return e;
+}
+
+bool NonlinearSolver::residual_at(Vec X, double s, Vec r) {
+  if (!is_known_state(X)) return problem_.residual(X, s, r);
+  problem_.residual_from_internal(known_force_, s, r);
+  return true;
 }
 
 TargetResult NonlinearSolver::solve_for_target(double target) {

@@ -155,7 +155,7 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
   LogEvent event(events().corrector);
   const double fnorm = problem_.load_norm();
   const double gtol = 0.1 * opt_.target_rtol * std::abs(d);
-  if (!problem_.residual(u_, s_, r_)) {
+  if (!residual_at(u_, s_, r_)) {
     why = "inadmissible state (det F <= 0)";
     return false;
   }
@@ -296,7 +296,7 @@ bool NonlinearSolver::predict(double d_next, std::string& why) {
   }
   const double dalpha = (d_next - m) / ca;
   const double s_pred = s_ + dalpha;
-  if (!problem_.residual(u_, s_pred, r_)) throw std::logic_error("a converged state is inadmissible");
+  if (!residual_at(u_, s_pred, r_)) throw std::logic_error("a converged state is inadmissible");
   HS_PETSC(VecAXPBY(du_, -dalpha, 0.0, a_));  // Y = -dalpha a
   const double lambda = backtrack(u_, du_, r_, s_pred, w_, b_);
   if (lambda > 0.0) {

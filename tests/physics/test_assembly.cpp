@@ -124,8 +124,8 @@ TEST_CASE("Re-assembly straight into the CSR values equals PETSc's assembly", "[
 }
 
 TEST_CASE("Energy and residual in one pass equal the two passes bit for bit", "[assembly]") {
-  // A line search's trial takes both from Problem::energy_residual; the solver's data must not
-  // depend on it. Both materials (pointwise and mean dilatation), every element.
+  // A line search's trial takes both from Problem::energy_residual, and the next line search
+  // starts from its stored energy and internal force; the solver's data must not depend on it. Both materials (pointwise and mean dilatation), every element.
   for (const Case& c : cases)
     for (const bool mean : {false, true}) {
       DYNAMIC_SECTION(c.name << (mean ? ", mean dilatation" : "")) {
@@ -138,7 +138,8 @@ TEST_CASE("Energy and residual in one pass equal the two passes bit for bit", "[
         double e = 0, e1 = 0, internal = 0;
         REQUIRE(p->energy(u, s, e));
         REQUIRE(p->residual(u, s, r));
-        REQUIRE(p->energy_residual(u, s, e1, r1, &internal));
+        core::VecH force = p->create_vector();
+        REQUIRE(p->energy_residual(u, s, e1, r1, &internal, force));
         REQUIRE(std::isfinite(e));
         CHECK(e1 == e);
         PetscBool same = PETSC_FALSE;
@@ -149,6 +150,12 @@ TEST_CASE("Energy and residual in one pass equal the two passes bit for bit", "[
         REQUIRE(p->energy(u, -1.25, e2));
         CHECK(p->energy_from_internal(u, -1.25, internal) == e2);
         CHECK(e2 != e);
+        // Likewise the stored energy's gradient and the residual at any load factor.
+        core::VecH r2 = p->create_vector(), r3 = p->create_vector();
+        REQUIRE(p->residual(u, -1.25, r2));
+        p->residual_from_internal(force, -1.25, r3);
+        HS_PETSC(VecEqual(r2, r3, &same));
+        CHECK(same);
         // Inadmissible (inverted) states: false, the residual left as it was.
         HS_PETSC(VecScale(u, 40.0));
         REQUIRE_FALSE(p->energy(u, s, e));

@@ -107,7 +107,13 @@ class Problem {
   bool residual(Vec u, double load_factor, Vec r) const;
   /// energy() and residual() in one pass over the cells (a line search's trial): the same
   /// numbers; `r` is left untouched where u is inadmissible. Not with a follower load.
-  bool energy_residual(Vec u, double load_factor, double& value, Vec r, double* internal = nullptr) const;
+  /// `internal_force` (if given): the stored energy's gradient alone, the part
+  /// residual_from_internal subtracts the loads from.
+  bool energy_residual(Vec u, double load_factor, double& value, Vec r, double* internal = nullptr,
+                       Vec internal_force = nullptr) const;
+  /// The residual at u from its `internal_force` (as energy_residual gave it at this u): the same
+  /// numbers as residual(), without the cells. Not with a follower load. Collective.
+  void residual_from_internal(Vec internal_force, double load_factor, Vec r) const;
   /// `load_factor` matters only for a scaled follower load (its load stiffness is s df_s/du).
   bool jacobian(Vec u, Mat J, double load_factor = 0.0) const;
   /// The same residual (load factor 0) and tangent through PETSc's generic pointwise assembly
@@ -134,7 +140,9 @@ class Problem {
   /// Global -> local with the essential values inserted.
   void to_local(Vec u, Vec ul) const;
   /// The global residual from the local array of the cells' sums: minus the loads.
-  void finish_residual(core::LocalArray& rl, double load_factor, Vec r) const;
+  void finish_residual(core::LocalArray& rl, double load_factor, Vec r, Vec internal_force = nullptr) const;
+  /// r -= load_factor f_ext + f_fixed.
+  void subtract_loads(double load_factor, Vec r) const;
   void assemble_load();
   /// Assembles the loads of the effects with scaled() == `scaled` into `f` (global).
   void assemble_loads(bool scaled, Vec f) const;

@@ -186,6 +186,11 @@ class NonlinearSolver {
   void accept_trial(Vec W, Vec X);
   /// The energy of X at load s: from the stored energy accept_trial kept if X is unchanged since.
   double energy_at_start(Vec X, double s);
+  /// R(X, s) into r, from the internal force accept_trial kept if X is unchanged since. False
+  /// where X is inadmissible.
+  bool residual_at(Vec X, double s, Vec r);
+  /// Whether X is bit for bit the state accept_trial kept the stored energy and force of.
+  bool is_known_state(Vec X);
   /// Newton's method on the SNES at load factor s from u_, converged when |R| <= atol + rtol (|s|
   /// |f_ext| + fixed_norm) (checked on the true residual; rtol <= 0: the options' rtol).
   bool newton(double s, SolveResult& r, double fixed_norm = 0, double rtol = 0);
@@ -296,10 +301,11 @@ class NonlinearSolver {
   std::vector<PetscInt> global_of_local_;  ///< see global_of_local()
   double s_ = 0;        ///< load factor of the current state
   double s_eval_ = 0;   ///< load factor the callbacks assemble at
-  /// The stored energy of the last trial backtrack evaluated (NaN: none), and of the state
-  /// accept_trial copied it to (known_state_, a copy: compared bit for bit, NaN: none).
+  /// The stored energy and internal force of the last trial backtrack evaluated (NaN: none),
+  /// and of the state accept_trial copied it to (known_state_, a copy: compared bit for bit;
+  /// NaN: none).
   double trial_internal_ = NAN, known_internal_ = NAN;
-  core::VecH known_state_;
+  core::VecH trial_force_, known_force_, known_state_;
   double step_hint_ = 0;
   double s0_ = 0;       ///< load factor of the state a branch switch left (in v0_)
   int negative_pivots_ = -1;  ///< inertia of the last tangent_response() (-1: unknown)
