@@ -2,7 +2,7 @@
 # The validation of the labels' error estimate in docs/ACCURACY.md ("Every label knows its own
 # error"): build/study_error_estimate on the accuracy study's scenes and on random Random2D /
 # Random3D load cases, then scripts/error_estimate_report.py (table + log-log plot).
-#   scripts/error_estimate_study.sh [PART...]    parts: random2d scenes2d p2 random3d random3d_h03 scenes3d report
+#   scripts/error_estimate_study.sh [PART...]    parts: random2d scenes2d p2 random2d_p2 graded random3d random3d_h03 scenes3d report
 #                                                (default: all; each appends to docs/error_estimate/PART.jsonl)
 # One rank, OPENBLAS_NUM_THREADS=1; references with MUMPS (-ref_ prefix). Runtime on the shared
 # 2-core VM: random2d ~10 min, scenes2d ~5, p2 ~10, random3d/scenes3d ~10 each.
@@ -14,7 +14,7 @@ mkdir -p "$OUT" docs/figures
 export OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
 ref=(-ref_pc_factor_mat_solver_type mumps)
 parts=("$@")
-[ ${#parts[@]} -gt 0 ] || parts=(random2d scenes2d p2 random3d scenes3d report)
+[ ${#parts[@]} -gt 0 ] || parts=(random2d scenes2d p2 random2d_p2 random3d scenes3d report)
 for part in "${parts[@]}"; do
   case $part in
     random2d)  # 17 Random2D shapes x 3 load cases, as the preset generates them (P1, h 0.04)
@@ -23,6 +23,19 @@ for part in "${parts[@]}"; do
       for s in disk r2d-0 r2d-1 ood-0 easy-0; do "$BIN" --scene $s --out "$OUT/scenes2d.jsonl" -- "${ref[@]}"; done ;;
     p2)        # P2 on the same scenes at h 0.08 (references P2 at h 0.04 and 0.02)
       for s in disk r2d-0 r2d-1 ood-0; do "$BIN" --scene $s --degree 2 --h 0.08 --out "$OUT/p2.jsonl" -- "${ref[@]}"; done ;;
+    random2d_p2)  # Random2D shapes no other run used (20-27), P2 at h 0.08, 2 load cases each
+      "$BIN" --preset random2d --degree 2 --h 0.08 --shapes $(seq 20 27) --loads 2 --out "$OUT/random2d_p2.jsonl" -- "${ref[@]}" ;;
+    graded)    # the same on meshes graded towards the clamp ends (h/8, h/32 there), and the estimate
+               # with Newton to tolerance on the fine mesh (estimate only: joined with the truths above)
+      mkdir -p "$OUT/graded"
+      "$BIN" --preset random2d --degree 2 --h 0.08 --graded 0.125 --shapes $(seq 20 27) --loads 2 \
+        --out "$OUT/graded/random2d_p2_graded0.125.jsonl" -- "${ref[@]}"
+      "$BIN" --preset random2d --degree 2 --h 0.08 --graded 0.03125 --shapes 20 21 22 23 --loads 2 \
+        --out "$OUT/graded/random2d_p2_graded0.03125.jsonl" -- "${ref[@]}"
+      "$BIN" --preset random2d --degree 2 --h 0.08 --shapes $(seq 20 27) --loads 2 --fine-newton --estimate-only \
+        --out "$OUT/graded/random2d_p2_fine_newton_estimate_only.jsonl"
+      "$BIN" --preset random2d --degree 2 --h 0.08 --graded 0.125 --shapes $(seq 20 27) --loads 2 --fine-newton \
+        --estimate-only --out "$OUT/graded/random2d_p2_graded0.125_fine_newton_estimate_only.jsonl" ;;
     random3d)  # Random3D shapes (P2) as the preset solves them, coarser (mesh.h 0.5) so that a
                # reference two refinements finer stays within reach of one core
       "$BIN" --preset random3d --h 0.5 --shapes 0 1 2 3 4 --loads 2 --levels 2 --out "$OUT/random3d.jsonl" -- "${ref[@]}" ;;

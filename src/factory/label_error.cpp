@@ -11,7 +11,8 @@
 namespace hypershape::factory {
 
 LabelErrorEstimator::LabelErrorEstimator(MPI_Comm group, const config::DatasetConfig& cfg, const ShapeSample& shape,
-                                         const LoadCase& first, const physics::Problem& coarse)
+                                         const LoadCase& first, const physics::Problem& coarse,
+                                         bool newton_to_tolerance)
     : refined_(mesh::refine_uniform(shape.mesh)) {
   // The fine shape differs only in its mesh: the scene's placements (p_D, r, the loads) come
   // from the shape and the load case, so the fine problem is the same boundary-value problem.
@@ -22,7 +23,7 @@ LabelErrorEstimator::LabelErrorEstimator(MPI_Comm group, const config::DatasetCo
   fine_ = make_shape_problem(group, cfg, fine_shape_, first, physics::SpaceOptions{coarse.space().degree()});
   // The mean-dilatation element: Newton to tolerance on the fine mesh (TwoLevelEstimator).
   estimator_ = std::make_unique<solver::TwoLevelEstimator>(coarse, *fine_.problem, refined_,
-                                                           cfg.material.dilatation == "mean");
+                                                           newton_to_tolerance || cfg.material.dilatation == "mean");
 }
 
 solver::ErrorEstimate LabelErrorEstimator::estimate(const config::DatasetConfig& cfg, const LoadCase& lc, Vec u,

@@ -1,6 +1,8 @@
 // Validation of the labels' error estimate (see include/hypershape/study/error_estimate_study.hpp).
 #include "hypershape/study/error_estimate_study.hpp"
 
+#include "hypershape/factory/accuracy.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -9,6 +11,7 @@
 
 #include "accuracy_detail.hpp"
 #include "hypershape/core/timer.hpp"
+#include "hypershape/factory/accuracy.hpp"
 #include "hypershape/factory/dataset_scene.hpp"
 #include "hypershape/factory/label_error.hpp"
 #include "hypershape/study/error_estimate_study.hpp"
@@ -108,13 +111,14 @@ void true_errors(const std::vector<Level>& levels, std::vector<double> uh, const
 
 /// Solves and estimates every load case of one shape and measures the truth, a line each.
 void run_shape(const config::DatasetConfig& cfg, const factory::ShapeSample& shape,
-               const std::vector<factory::LoadCase>& cases, int n_levels, const std::string& label, std::ostream& out) {
+               const std::vector<factory::LoadCase>& cases, int n_levels, bool fine_newton, const std::string& label,
+               std::ostream& out) {
   const MPI_Comm comm = PETSC_COMM_WORLD;
   const double t_setup = core::now_seconds();
   factory::ShapeProblem sp = factory::make_shape_problem(comm, cfg, shape, cases[0]);
   solver::NonlinearSolver nl(*sp.problem, cfg.solver);
   const double t_est0 = core::now_seconds();
-  factory::LabelErrorEstimator est(comm, cfg, shape, cases[0], *sp.problem);
+  factory::LabelErrorEstimator est(comm, cfg, shape, cases[0], *sp.problem, fine_newton);
   const double est_setup = core::now_seconds() - t_est0;
   std::vector<Level> levels(static_cast<std::size_t>(n_levels));
   const mesh::MeshData* coarser = &shape.mesh;
@@ -196,8 +200,10 @@ void run_estimate_study(const EstimateStudyOptions& o, std::ostream& out) {
   const int d = cfg.shapes.dim;
   if (o.h > 0) (d == 3 && cfg.shapes.mesh_h > 0 ? cfg.shapes.mesh_h : cfg.shapes.h) = o.h;
   const int n_levels = !o.references ? 0 : o.levels > 0 ? o.levels : (d == 2 ? 2 : 1);
-  const std::string label = fmt::format("{}-P{}-h{:g}", o.scene.empty() ? o.preset : o.scene, cfg.degree,
-                                        accuracy::preset_mesh_h(cfg));
+  if (o.graded > 0 && (d != 2 || !o.scene.empty())) throw std::invalid_argument("--graded: 2D random shapes only");
+  const std::string label = fmt::format("{}-P{}-h{:g}{}{}", o.scene.empty() ? o.preset : o.scene, cfg.degree,
+                                        accuracy::preset_mesh_h(cfg), o.graded > 0 ? fmt::format("-graded{:g}", o.graded) : "",
+                                        o.fine_newton ? "-fine-newton" : "");
   if (!o.scene.empty()) {
     const double h = accuracy::preset_mesh_h(cfg);
     accuracy::ShapeCache cache(spec->kind, cfg.shapes, cfg.seed, spec->shape_id, std::min(h, cfg.shapes.h));
@@ -208,15 +214,16 @@ void run_estimate_study(const EstimateStudyOptions& o, std::ostream& out) {
     const double targets[3] = {0.1, 0.3, 0.5};
     for (std::size_t l = 0; l < cases.size(); ++l) cases[l].target = targets[l];
     cases.resize(std::size_t(std::min(o.loads, 3)));
-    run_shape(cfg, shape, cases, n_levels, label, out);
+    run_shape(cfg, shape, cases, n_levels, o.fine_newton, label, out);
     return;
   }
   const auto base = factory::load_base(cfg.shapes);
   for (std::int64_t id : o.shapes) {
-    const auto shape = factory::make_shape(factory::shape_config(cfg, id), base, cfg.seed, id);
+    auto shape = factory::make_shape(factory::shape_config(cfg, id), base, cfg.seed, id);
+    if (o.graded > 0) shape = factory::grade_shape(shape, cfg.shapes.h, o.graded * cfg.shapes.h, factory::kGradeGrowth);
     auto cases = factory::draw_load_cases(shape, cfg.loads, cfg.seed, factory::n_tractions(cfg));
     cases.resize(std::size_t(std::min<int>(o.loads, int(cases.size()))));
-    run_shape(cfg, shape, cases, n_levels, label, out);
+    run_shape(cfg, shape, cases, n_levels, o.fine_newton, label, out);
   }
 }
 

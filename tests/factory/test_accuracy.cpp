@@ -108,6 +108,68 @@ TEST_CASE("The accuracy ladder and its prediction", "[factory][accuracy]") {
   CHECK(factory::accuracy_level(c, 1).refinements == 1);
 }
 
+TEST_CASE("grade_shape keeps the polygon and its patch and grades the mesh towards the clamp ends",
+          "[factory][accuracy]") {
+  const auto c = config::parse_dataset_text(head, "<test>");
+  const auto s = factory::make_shape(factory::shape_config(c, 1), std::nullopt, c.seed, 1);
+  const double h = 0.08, end = h / 32;
+  const auto g = factory::grade_shape(s, h, end, 0.3);
+  const auto [area, positive] = mesh_measure(g.mesh);
+  CHECK(positive);
+  CHECK(area == Approx(mesh_measure(s.mesh).first).epsilon(1e-12));
+  check_boundary_on_mesh(g);
+  for (std::int64_t f = 0; f + 1 < g.boundary.n_facets(); ++f) CHECK(g.boundary.facet(f)[1] == g.boundary.facet(f + 1)[0]);
+  // Every drawn point is kept, in order; the points added lie on the drawn segment they split.
+  std::int64_t j = 0;
+  for (std::int64_t i = 0; i < s.boundary.n_points(); ++i) {
+    const auto p = s.boundary.point(i), q = s.boundary.point((i + 1) % s.boundary.n_points());
+    while (g.boundary.point(j)[0] != p[0] || g.boundary.point(j)[1] != p[1]) {
+      REQUIRE(j > 0);  // an added point: on the previous segment
+      ++j;
+      REQUIRE(j < g.boundary.n_points());
+    }
+    for (++j; j < g.boundary.n_points() && (g.boundary.point(j)[0] != q[0] || g.boundary.point(j)[1] != q[1]); ++j) {
+      const auto x = g.boundary.point(j);
+      const double cross = (q[0] - p[0]) * (x[1] - p[1]) - (q[1] - p[1]) * (x[0] - p[0]);
+      CHECK(std::abs(cross) < 1e-14);
+      const double t = ((x[0] - p[0]) * (q[0] - p[0]) + (x[1] - p[1]) * (q[1] - p[1])) /
+                       ((q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]));
+      CHECK((t > 0 && t < 1));
+    }
+  }
+  // The patch: the same facets' union (the children of the drawn patch's facets), the same ends.
+  CHECK(g.dirichlet_facets == geometry::facets_in_ball(g.boundary, s.dirichlet_center, s.dirichlet_radius));
+  double patch = 0, patch_drawn = 0;
+  for (int f : g.dirichlet_facets) patch += geometry::facet_measure(g.boundary, f);
+  for (int f : s.dirichlet_facets) patch_drawn += geometry::facet_measure(s.boundary, f);
+  CHECK(patch == Approx(patch_drawn).epsilon(1e-12));
+  const auto ends = factory::clamp_ends(g);
+  REQUIRE(ends == factory::clamp_ends(s));
+  REQUIRE(ends.size() == 2);
+  // Graded: the facets at an end are about `end` long; points are added only where the wanted size
+  // (end + 0.3 x distance to the nearest end) is below the drawn facets' longest.
+  double longest = 0;
+  std::set<std::array<double, 2>> drawn;
+  for (std::int64_t f = 0; f < s.boundary.n_facets(); ++f) longest = std::max(longest, geometry::facet_measure(s.boundary, f));
+  for (std::int64_t i = 0; i < s.boundary.n_points(); ++i) drawn.insert({s.boundary.point(i)[0], s.boundary.point(i)[1]});
+  int added = 0;
+  for (std::int64_t f = 0; f < g.boundary.n_facets(); ++f) {
+    const auto a = g.boundary.point(g.boundary.facet(f)[0]);
+    double d = 1e300;
+    for (const auto& e : ends) d = std::min(d, std::hypot(a[0] - e[0], a[1] - e[1]));
+    if (d == 0) CHECK(geometry::facet_measure(g.boundary, f) < 1.5 * end);
+    if (!drawn.contains({a[0], a[1]})) {
+      ++added;
+      CHECK(end + 0.3 * d < 1.5 * longest);
+    }
+  }
+  CHECK(added > 10);
+  CHECK(g.mesh.n_vertices() > 0.9 * double(s.mesh.n_vertices()));
+  CHECK(g.mesh.n_vertices() < 1.5 * double(s.mesh.n_vertices()));
+  // Deterministic: the same input, the same mesh.
+  CHECK(factory::grade_shape(s, h, end, 0.3).mesh.coords == g.mesh.coords);
+}
+
 TEST_CASE("refine_shape keeps the shape, its patch and the boundary-first numbering", "[factory][accuracy]") {
   const auto c = config::parse_dataset_text(head, "<test>");
   const auto s = factory::make_shape(factory::shape_config(c, 1), std::nullopt, c.seed, 1);

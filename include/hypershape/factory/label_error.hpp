@@ -22,10 +22,11 @@ namespace hypershape::factory {
 
 class LabelErrorEstimator {
  public:
-  /// `coarse`: the shape's problem (built by make_shape_problem from `shape`). Collective over
-  /// `group`.
+  /// `coarse`: the shape's problem (built by make_shape_problem from `shape`). The fine Newton
+  /// runs to tolerance for the mean-dilatation element, or where `newton_to_tolerance` (the
+  /// estimate study's --fine-newton). Collective over `group`.
   LabelErrorEstimator(MPI_Comm group, const config::DatasetConfig& cfg, const ShapeSample& shape,
-                      const LoadCase& first, const physics::Problem& coarse);
+                      const LoadCase& first, const physics::Problem& coarse, bool newton_to_tolerance = false);
   /// Sets the fine problem to load case `lc` and estimates the error of `u` at `alpha`
   /// (`coarse_solve`: the nonlinear solver's factor, TwoLevelEstimator::estimate). Collective.
   solver::ErrorEstimate estimate(const config::DatasetConfig& cfg, const LoadCase& lc, Vec u, double alpha,
