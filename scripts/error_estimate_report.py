@@ -83,6 +83,8 @@ def main():
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
         fig, axes = plt.subplots(1, 3, figsize=(15, 4.8))
+        # One colour per family (the default cycle repeats after 10), 3D drawn as squares.
+        colours = {name: plt.cm.tab20(k % 20) for k, name in enumerate(sorted(families))}
         for ax, (q, title) in zip(axes, QUANTITIES):
             lo, hi = np.inf, 0
             for name in sorted(families):
@@ -91,7 +93,8 @@ def main():
                 e = np.array([abs(r[f"est_{q}"]) for r in fr])
                 keep = (t > 0) & (e > 0)
                 if keep.any():
-                    ax.loglog(t[keep], e[keep], "o", ms=4, alpha=0.75, label=name)
+                    marker = "s" if fr[0].get("dim") == 3 else "o"
+                    ax.loglog(t[keep], e[keep], marker, ms=4, alpha=0.75, color=colours[name], label=name)
                     lo, hi = min(lo, t[keep].min(), e[keep].min()), max(hi, t[keep].max(), e[keep].max())
             if hi > 0:
                 x = np.array([lo / 2, hi * 2])
