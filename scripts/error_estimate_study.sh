@@ -2,7 +2,7 @@
 # The validation of the labels' error estimate in docs/ACCURACY.md ("Every label knows its own
 # error"): build/study_error_estimate on the accuracy study's scenes and on random Random2D /
 # Random3D load cases, then scripts/error_estimate_report.py (table + log-log plot).
-#   scripts/error_estimate_study.sh [PART...]    parts: random2d scenes2d p2 random2d_p2 graded random3d random3d_h03 scenes3d report
+#   scripts/error_estimate_study.sh [PART...]    parts: random2d scenes2d p2 random2d_p2 easy_random2d_p2 graded random3d random3d_h03 scenes3d report
 #                                                (default: all; each appends to docs/error_estimate/PART.jsonl)
 # One rank, OPENBLAS_NUM_THREADS=1; references with MUMPS (-ref_ prefix). Runtime on the shared
 # 2-core VM: random2d ~10 min, scenes2d ~5, p2 ~10, random3d/scenes3d ~10 each.
@@ -14,7 +14,7 @@ mkdir -p "$OUT" docs/figures
 export OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
 ref=(-ref_pc_factor_mat_solver_type mumps)
 parts=("$@")
-[ ${#parts[@]} -gt 0 ] || parts=(random2d scenes2d p2 random2d_p2 random3d scenes3d report)
+[ ${#parts[@]} -gt 0 ] || parts=(random2d scenes2d p2 random2d_p2 easy_random2d_p2 random3d scenes3d report)
 for part in "${parts[@]}"; do
   case $part in
     random2d)  # 17 Random2D shapes x 3 load cases, as the preset generates them (P1, h 0.04)
@@ -25,6 +25,8 @@ for part in "${parts[@]}"; do
       for s in disk r2d-0 r2d-1 ood-0; do "$BIN" --scene $s --degree 2 --h 0.08 --out "$OUT/p2.jsonl" -- "${ref[@]}"; done ;;
     random2d_p2)  # Random2D shapes no other run used (20-27), P2 at h 0.08, 2 load cases each
       "$BIN" --preset random2d --degree 2 --h 0.08 --shapes $(seq 20 27) --loads 2 --out "$OUT/random2d_p2.jsonl" -- "${ref[@]}" ;;
+    easy_random2d_p2)  # EasyRandom2D at its preset's P2 h 0.12, the same unused shapes
+      "$BIN" --preset easy_random2d --shapes $(seq 20 27) --loads 2 --out "$OUT/easy_random2d_p2.jsonl" -- "${ref[@]}" ;;
     graded)    # the same on meshes graded towards the clamp ends (h/8, h/32 there), and the estimate
                # with Newton to tolerance on the fine mesh (estimate only: joined with the truths above)
       mkdir -p "$OUT/graded"
