@@ -690,35 +690,49 @@ def shape_error_estimates(ds, shape_id):
     return np.stack([gl[k][...] for k in ERROR_ESTIMATES], axis=1).astype(np.float64)
 
 
+# A label that took more than this many times the dataset's median Newton iterations is counted
+# as possibly near a limit point of the load, where the estimate can undershoot (docs/ACCURACY.md,
+# "Random2D at P2": 7x on a label of 76 iterations against a median of 17). A warning count, not a
+# classification: most such labels are well estimated.
+NEAR_LIMIT_ITERATIONS = 3.0
+
+
 def error_estimates(ds, worst=5):
     """The labels' own error estimates over a dataset's converged load cases: per estimate its
-    distribution (quantiles of the magnitude), and the `worst` load cases by the relative L2
-    estimate. None when the dataset stores no estimates."""
-    rows = []  # (shape, load, rel_l2, max_u, alpha)
+    distribution (quantiles of the magnitude), the `worst` load cases by the relative L2 estimate
+    (with their Newton iterations), and how many estimated labels took more than
+    NEAR_LIMIT_ITERATIONS x the median Newton iterations. None when the dataset stores no estimates."""
+    rows, its = [], []  # (shape, load, rel_l2, max_u, alpha); Newton iterations
     for sid in ds.shape_ids():
         gl = ds._group(sid)["loads"]
         if ERROR_ESTIMATES[0] not in gl:
             return None
         st = gl["status"][...]
         cols = [gl[k][...] for k in ERROR_ESTIMATES]
+        n_it = gl["newton_iterations"][...]
         rows += [(sid, k, *(float(c[k]) for c in cols)) for k in range(len(st)) if st[k]]
+        its += [int(n_it[k]) for k in range(len(st)) if st[k]]
     if not rows:
         return None
     a = np.array([r[2:] for r in rows])
+    its = np.array(its)
     missing = int((a[:, 0] < 0).sum())  # -1: no estimate could be formed
     inverted = int((a[:, 0] == -2).sum())  # -2: nor can be, the label inverts inside a cell
     rows = [r for r, k in zip(rows, a[:, 0] >= 0) if k]
+    its = its[a[:, 0] >= 0]
     a = a[a[:, 0] >= 0]
     if not rows:
         return {"load_cases": 0, "without_estimate": missing, "inverted_in_a_cell": inverted,
-                "distribution_of_magnitude": {}, "worst_by_rel_l2": []}
+                "distribution_of_magnitude": {}, "worst_by_rel_l2": [], "many_newton_iterations": 0}
     q = (50, 90, 99, 100)
     dist = {k: {f"p{p}": float(np.percentile(np.abs(a[:, i]), p)) for p in q} for i, k in enumerate(ERROR_ESTIMATES)}
     order = np.argsort(-a[:, 0])[:worst]
     return {"load_cases": len(rows), "without_estimate": missing, "inverted_in_a_cell": inverted,
             "distribution_of_magnitude": dist,
             "worst_by_rel_l2": [{"shape": rows[i][0], "load": rows[i][1], "rel_l2": rows[i][2],
-                                 "max_u": rows[i][3], "alpha": rows[i][4]} for i in order]}
+                                 "max_u": rows[i][3], "alpha": rows[i][4],
+                                 "newton_iterations": int(its[i])} for i in order],
+            "many_newton_iterations": int((its > NEAR_LIMIT_ITERATIONS * np.median(its)).sum())}
 
 
 def print_error_estimates(e, out=sys.stdout):
@@ -730,7 +744,10 @@ def print_error_estimates(e, out=sys.stdout):
     for k, d in e["distribution_of_magnitude"].items():
         w(f"    {k:<24}" + "  ".join(f"{p} {v:.3g}" for p, v in d.items()))
     w("    worst load cases by rel_l2: " + ", ".join(
-        f"shape {r['shape']} load {r['load']} ({r['rel_l2']:.3g})" for r in e["worst_by_rel_l2"]))
+        f"shape {r['shape']} load {r['load']} ({r['rel_l2']:.3g}, {r['newton_iterations']} Newton its)"
+        for r in e["worst_by_rel_l2"]))
+    w(f"    {e['many_newton_iterations']} estimated labels took more than {NEAR_LIMIT_ITERATIONS:g}x the median Newton "
+      "iterations: near a limit point of the load an estimate can undershoot (docs/ACCURACY.md)")
 
 
 def check_dataset(path, out=sys.stdout):

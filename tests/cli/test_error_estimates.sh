@@ -39,7 +39,10 @@ assert n >= 4, n
 PY
 /usr/bin/python3 "$src/scripts/hypershape_data.py" summary "$work/ds" > "$work/summary.txt" 2>&1 || fail "summary"
 grep -q "label error estimates over" "$work/summary.txt" && grep -q "worst load cases by rel_l2" "$work/summary.txt" \
-  && ok "summary: distribution and worst load cases" || { cat "$work/summary.txt"; fail "summary lines"; }
+  && grep -Eq "worst load cases by rel_l2: shape [0-9]+ load [0-9]+ \([^,]+, [0-9]+ Newton its\)" "$work/summary.txt" \
+  && grep -Eq "[0-9]+ estimated labels took more than 3x the median Newton iterations" "$work/summary.txt" \
+  && ok "summary: distribution, worst load cases with their Newton iterations, the count near limit points" \
+  || { cat "$work/summary.txt"; fail "summary lines"; }
 /usr/bin/python3 - "$src/scripts" "$work/ds" <<'PY' && ok "torch Datasets: error_estimate per item, max_error filters" || fail "torch Datasets"
 import sys; sys.path.insert(0, sys.argv[1])
 import numpy as np, hypershape_torch as ht
