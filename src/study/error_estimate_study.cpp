@@ -1,8 +1,6 @@
 // Validation of the labels' error estimate (see include/hypershape/study/error_estimate_study.hpp).
 #include "hypershape/study/error_estimate_study.hpp"
 
-#include "hypershape/factory/accuracy.hpp"
-
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -14,7 +12,6 @@
 #include "hypershape/factory/accuracy.hpp"
 #include "hypershape/factory/dataset_scene.hpp"
 #include "hypershape/factory/label_error.hpp"
-#include "hypershape/study/error_estimate_study.hpp"
 
 namespace hypershape::study {
 

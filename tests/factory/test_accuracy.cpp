@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <set>
+#include <stdexcept>
 #include <string>
 
 #include "hypershape/config/dataset.hpp"
@@ -168,6 +169,10 @@ TEST_CASE("grade_shape keeps the polygon and its patch and grades the mesh towar
   CHECK(g.mesh.n_vertices() < 1.5 * double(s.mesh.n_vertices()));
   // Deterministic: the same input, the same mesh.
   CHECK(factory::grade_shape(s, h, end, 0.3).mesh.coords == g.mesh.coords);
+  // 2D only: a 3D shape is refused before any meshing.
+  factory::ShapeSample s3;
+  s3.mesh.dim = 3;
+  CHECK_THROWS_AS(factory::grade_shape(s3, h, end, 0.3), std::invalid_argument);
 }
 
 TEST_CASE("refine_shape keeps the shape, its patch and the boundary-first numbering", "[factory][accuracy]") {
