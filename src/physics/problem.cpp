@@ -31,6 +31,16 @@ bool all_ranks(MPI_Comm comm, bool ok) {
   return v == 1;
 }
 
+/// PETSc's pointwise assembly reads closures through the closure index (3D P1 residual 4.8x
+/// faster with it); only it does, so it is built at its first call, not with every space.
+void ensure_closure_index(DM dm) {
+  PetscSection s, cl_section = nullptr;
+  IS cl_points = nullptr;
+  HS_PETSC(DMGetLocalSection(dm, &s));
+  HS_PETSC(PetscSectionGetClosureIndex(s, (PetscObject)dm, &cl_section, &cl_points));
+  if (!cl_section) HS_PETSC(DMPlexCreateClosureIndex(dm, nullptr));
+}
+
 }  // namespace
 
 Problem::Problem(MPI_Comm comm, const mesh::MeshData& mesh, std::vector<EffectPtr> effects,
@@ -245,6 +255,7 @@ bool Problem::jacobian(Vec u, Mat J, double load_factor) const {
 }
 
 void Problem::residual_pointwise(Vec u, Vec r) const {
+  ensure_closure_index(dm());
   PetscDS ds;
   HS_PETSC(DMGetDS(dm(), &ds));
   for (auto& eff : effects_)
@@ -257,6 +268,7 @@ void Problem::residual_pointwise(Vec u, Vec r) const {
 }
 
 void Problem::jacobian_pointwise(Vec u, Mat J) const {
+  ensure_closure_index(dm());
   PetscDS ds;
   HS_PETSC(DMGetDS(dm(), &ds));
   for (auto& eff : effects_)
@@ -405,9 +417,8 @@ NodalField Problem::gather(Vec u) const {
 }
 
 core::MatH Problem::create_matrix() const {
-  // DMCreateMatrix preallocates and inserts the whole pattern (27 ms at 5k unknowns, measured:
-  // five matrices per shape); a copy of the first one's pattern costs a memcpy.
-  if (!pattern_) HS_PETSC(DMCreateMatrix(dm(), pattern_.out()));
+  // The pattern once per problem (Space::create_matrix); a copy of it costs a memcpy.
+  if (!pattern_) pattern_ = space_->create_matrix();
   core::MatH J;
   HS_PETSC(MatDuplicate(pattern_, MAT_DO_NOT_COPY_VALUES, J.out()));
   if (!conservative()) return J;  // a follower load's stiffness is not symmetric

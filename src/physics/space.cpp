@@ -245,7 +245,6 @@ void Space::create_fe(const SpaceOptions& opt, const std::vector<EssentialBC>& b
                            PetscInt(bc.components.size()), bc.components.data(),
                            (void (*)(void))zero_value, nullptr, nullptr, nullptr));
   }
-  HS_PETSC(DMPlexCreateClosureIndex(dm_, nullptr));
 }
 
 void Space::tabulate_cell_rule(PetscQuadrature q) {
@@ -488,6 +487,67 @@ const std::vector<PetscInt>& Space::csr_offsets(const PetscInt* ia, const PetscI
     }
   }
   return csr_offsets_;
+}
+
+namespace {
+
+/// CSR pattern of the local rows [0, n) (serial: global = local indices): for each row, the
+/// sorted free dofs of the cells that carry it. Cells listed per row first, then one marker pass.
+void cell_pattern(PetscInt n, PetscInt n_cells, int nd, const PetscInt* gdofs, std::vector<PetscInt>& ia,
+                  std::vector<PetscInt>& ja) {
+  std::vector<PetscInt> start(std::size_t(n) + 1, 0);
+  const auto dof = [&](PetscInt c, int i) { return gdofs[std::size_t(c) * std::size_t(nd) + std::size_t(i)]; };
+  for (PetscInt c = 0; c < n_cells; ++c)
+    for (int i = 0; i < nd; ++i)
+      if (dof(c, i) >= 0) ++start[std::size_t(dof(c, i)) + 1];
+  for (std::size_t r = 0; r < std::size_t(n); ++r) start[r + 1] += start[r];
+  std::vector<PetscInt> cells(std::size_t(start.back())), fill(start.begin(), start.end() - 1);
+  for (PetscInt c = 0; c < n_cells; ++c)
+    for (int i = 0; i < nd; ++i)
+      if (dof(c, i) >= 0) cells[std::size_t(fill[std::size_t(dof(c, i))]++)] = c;
+  std::vector<PetscInt> mark(std::size_t(n), -1);
+  ia.assign(1, 0);
+  ja.clear();
+  for (PetscInt r = 0; r < n; ++r) {
+    const auto row_begin = ja.size();
+    for (auto k = start[std::size_t(r)]; k < start[std::size_t(r) + 1]; ++k)
+      for (int j = 0; j < nd; ++j) {
+        const PetscInt col = dof(cells[std::size_t(k)], j);
+        if (col >= 0 && mark[std::size_t(col)] != r) mark[std::size_t(col)] = r, ja.push_back(col);
+      }
+    std::sort(ja.begin() + std::ptrdiff_t(row_begin), ja.end());
+    ia.push_back(PetscInt(ja.size()));
+  }
+}
+
+}  // namespace
+
+core::MatH Space::create_matrix() const {
+  core::MatH J;
+  DM dm = dm_.get();
+  if (core::size(comm()) > 1) {
+    HS_PETSC(DMCreateMatrix(dm, J.out()));
+    return J;
+  }
+  // DMCreateMatrix without its preallocation: the type, sizes, block size, local-to-global map
+  // and DM as it sets them; then the pattern, from the cells.
+  HS_PETSC(DMSetMatrixPreallocateSkip(dm, PETSC_TRUE));
+  const PetscErrorCode err = DMCreateMatrix(dm, J.out());
+  HS_PETSC(DMSetMatrixPreallocateSkip(dm, PETSC_FALSE));
+  HS_PETSC(err);
+  PetscBool seqaij = PETSC_FALSE;
+  HS_PETSC(PetscObjectTypeCompare((PetscObject)J.get(), MATSEQAIJ, &seqaij));
+  if (!seqaij) {  // another type (-dm_mat_type): DMCreateMatrix's own preallocation
+    core::MatH K;
+    HS_PETSC(DMCreateMatrix(dm, K.out()));
+    return K;
+  }
+  PetscInt n;
+  HS_PETSC(MatGetLocalSize(J, &n, nullptr));
+  std::vector<PetscInt> ia, ja;
+  cell_pattern(n, c1_ - c0_, n_cell_dofs(), gdofs_.data(), ia, ja);
+  HS_PETSC(MatSeqAIJSetPreallocationCSR(J, ia.data(), ja.data(), nullptr));
+  return J;
 }
 
 CellMatrixAdder::CellMatrixAdder(const Space& space, Mat J) : space_(space), J_(J), n_(space.n_cell_dofs()) {

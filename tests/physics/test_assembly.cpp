@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <string>
 
 #include "support/helpers.hpp"
 
@@ -95,6 +96,47 @@ TEST_CASE("Hand-written residual and tangent equal PETSc's pointwise assembly", 
       core::MatH J = p->create_matrix();
       REQUIRE(p->jacobian(u, J));
       check_equals_pointwise(*p, u, J);
+    }
+  }
+}
+
+TEST_CASE("The tangent's matrix from the cells is DMCreateMatrix's: type, sizes, block size, pattern",
+          "[assembly]") {
+  for (const Case& c : cases) {
+    DYNAMIC_SECTION(c.name) {
+      auto p = make_problem(c.dim, c.degree);
+      core::MatH A = p->create_matrix(), B;
+      HS_PETSC(DMCreateMatrix(p->dm(), B.out()));
+      MatType ta, tb;
+      HS_PETSC(MatGetType(A, &ta));
+      HS_PETSC(MatGetType(B, &tb));
+      CHECK(std::string(ta) == std::string(tb));
+      PetscInt ma, na, mb, nb, bsa, bsb;
+      HS_PETSC(MatGetSize(A, &ma, &na));
+      HS_PETSC(MatGetSize(B, &mb, &nb));
+      HS_PETSC(MatGetBlockSize(A, &bsa));
+      HS_PETSC(MatGetBlockSize(B, &bsb));
+      CHECK(ma == mb);
+      CHECK(na == nb);
+      CHECK(bsa == bsb);
+      if (core::size(PETSC_COMM_WORLD) > 1) continue;  // there it is DMCreateMatrix's own
+      DM dm;
+      HS_PETSC(MatGetDM(A, &dm));
+      CHECK(dm == p->dm());
+      PetscInt n, m;
+      const PetscInt *ia, *ja, *ib, *jb;
+      PetscBool da, db;
+      HS_PETSC(MatGetRowIJ(A, 0, PETSC_FALSE, PETSC_FALSE, &n, &ia, &ja, &da));
+      HS_PETSC(MatGetRowIJ(B, 0, PETSC_FALSE, PETSC_FALSE, &m, &ib, &jb, &db));
+      REQUIRE((da && db && n == m));
+      REQUIRE(n > 0);
+      CHECK(std::equal(ia, ia + n + 1, ib));
+      CHECK(std::equal(ja, ja + ia[n], jb));
+      HS_PETSC(MatRestoreRowIJ(A, 0, PETSC_FALSE, PETSC_FALSE, &n, &ia, &ja, &da));
+      HS_PETSC(MatRestoreRowIJ(B, 0, PETSC_FALSE, PETSC_FALSE, &m, &ib, &jb, &db));
+      PetscReal norm;
+      HS_PETSC(MatNorm(A, NORM_FROBENIUS, &norm));
+      CHECK(norm == 0.0);
     }
   }
 }
