@@ -106,8 +106,9 @@ void broadcast(std::vector<T>& v, MPI_Datatype type, MPI_Comm comm) {
 
 }  // namespace
 
-double l2_norm_squared(int dim, int degree, const std::vector<double>& coords, const std::vector<std::int64_t>& cells,
-                       const std::vector<double>& field, int n_comp) {
+std::vector<double> l2_norms_squared(int dim, int degree, const std::vector<double>& coords,
+                                     const std::vector<std::int64_t>& cells,
+                                     const std::vector<const std::vector<double>*>& fields, int n_comp) {
   const int nv = dim + 1, npc = mesh::nodes_per_cell(dim, degree);
   // u = sum_ij C_ij l_i l_j (P2, homogeneous in the barycentric l since sum l = 1) or
   // sum_i c_i l_i (P1); u^2 integrates exactly through the monomial means.
@@ -124,35 +125,43 @@ double l2_norm_squared(int dim, int degree, const std::vector<double>& coords, c
           m4[std::size_t(((i * nv + j) * nv + k) * nv + l)] = monomial_mean(dim, b);
         }
     }
-  double total = 0;
+  // int_T u^2 / |T| of one component of one field.
+  auto cell_mean_square = [&](const std::vector<double>& field, const std::int64_t* v, int k) {
+    auto val = [&](int a) { return field[std::size_t(v[a] * n_comp + k)]; };
+    double s = 0;
+    if (degree == 1) {
+      for (int i = 0; i < nv; ++i)
+        for (int j = 0; j < nv; ++j) s += val(i) * val(j) * m2[std::size_t(i * nv + j)];
+      return s;
+    }
+    double C[4][4] = {};
+    for (int a = 0; a < nv; ++a) {
+      C[a][a] += val(a);
+      for (int b = 0; b < nv; ++b)
+        if (b != a) C[a][b] -= 0.5 * val(a), C[b][a] -= 0.5 * val(a);
+    }
+    int e = nv;
+    for (const auto& [a, b] : mesh::edges(dim)) C[a][b] += 2 * val(e), C[b][a] += 2 * val(e), ++e;
+    for (int i = 0; i < nv; ++i)
+      for (int j = 0; j < nv; ++j)
+        for (int q = 0; q < nv; ++q)
+          for (int r = 0; r < nv; ++r) s += C[i][j] * C[q][r] * m4[std::size_t(((i * nv + j) * nv + q) * nv + r)];
+    return s;
+  };
+  std::vector<double> total(fields.size(), 0.0);
   const std::size_t n_cells = cells.size() / std::size_t(npc);
   for (std::size_t c = 0; c < n_cells; ++c) {
     const std::int64_t* v = &cells[c * std::size_t(npc)];
-    const double vol = cell_measure(dim, coords, v);
-    for (int k = 0; k < n_comp; ++k) {
-      auto val = [&](int a) { return field[std::size_t(v[a] * n_comp + k)]; };
-      double s = 0;
-      if (degree == 1) {
-        for (int i = 0; i < nv; ++i)
-          for (int j = 0; j < nv; ++j) s += val(i) * val(j) * m2[std::size_t(i * nv + j)];
-      } else {
-        double C[4][4] = {};
-        for (int a = 0; a < nv; ++a) {
-          C[a][a] += val(a);
-          for (int b = 0; b < nv; ++b)
-            if (b != a) C[a][b] -= 0.5 * val(a), C[b][a] -= 0.5 * val(a);
-        }
-        int e = nv;
-        for (const auto& [a, b] : mesh::edges(dim)) C[a][b] += 2 * val(e), C[b][a] += 2 * val(e), ++e;
-        for (int i = 0; i < nv; ++i)
-          for (int j = 0; j < nv; ++j)
-            for (int q = 0; q < nv; ++q)
-              for (int r = 0; r < nv; ++r) s += C[i][j] * C[q][r] * m4[std::size_t(((i * nv + j) * nv + q) * nv + r)];
-      }
-      total += vol * s;
-    }
+    const double vol = cell_measure(dim, coords, v);  // once for all fields
+    for (std::size_t f = 0; f < fields.size(); ++f)
+      for (int k = 0; k < n_comp; ++k) total[f] += vol * cell_mean_square(*fields[f], v, k);
   }
   return total;
+}
+
+double l2_norm_squared(int dim, int degree, const std::vector<double>& coords, const std::vector<std::int64_t>& cells,
+                       const std::vector<double>& field, int n_comp) {
+  return l2_norms_squared(dim, degree, coords, cells, {&field}, n_comp)[0];
 }
 
 namespace {
@@ -337,10 +346,11 @@ std::array<double, 6> estimate_values(const Space& fs, const std::vector<double>
     te[i] = theta * ev[i], uf[i] = pu[i] + te[i], uf1[i] = pu[i] + ev[i];
   const auto& x = fs.canonical_coords();
   const auto& cells = fs.canonical_cells();
-  const double ee = l2_norm_squared(d, p, x, cells, ev, d);
+  const std::vector<double> n2 = l2_norms_squared(d, p, x, cells, {&ev, &uf, &uf1}, d);  // one pass
+  const double ee = n2[0];
   const double mp = max_node(pu, d);
-  vals[0] = std::sqrt(theta * theta * ee / l2_norm_squared(d, p, x, cells, uf, d));
-  vals[1] = std::sqrt(ee / l2_norm_squared(d, p, x, cells, uf1, d));
+  vals[0] = std::sqrt(theta * theta * ee / n2[1]);
+  vals[1] = std::sqrt(ee / n2[2]);
   vals[2] = mp > 0 ? (max_node(uf, d) - mp) / mp : 0;
   vals[3] = mp > 0 ? (max_node(uf1, d) - mp) / mp : 0;
   // dmax/dalpha at the node of max |u_h|: (u_k / |u_k|) . a_k.

@@ -55,6 +55,10 @@ struct ErrorEstimate {
 /// on straight-sided simplices given by `coords` and `cells` (VTK order). Not collective.
 double l2_norm_squared(int dim, int degree, const std::vector<double>& coords,
                        const std::vector<std::int64_t>& cells, const std::vector<double>& field, int n_comp);
+/// The same for several fields in one pass over the cells (each as l2_norm_squared gives it).
+std::vector<double> l2_norms_squared(int dim, int degree, const std::vector<double>& coords,
+                                     const std::vector<std::int64_t>& cells,
+                                     const std::vector<const std::vector<double>*>& fields, int n_comp);
 
 /// y = K_c^-1 x with a factor of the coarse tangent at (or next to) u_h; false on failure.
 /// `refined` false: the two-grid preconditioner's coarse level, where a single-precision factor's
