@@ -190,7 +190,7 @@ class HyperelasticEffect : public Effect {
 
   // add_residual's loop with the energy in it. Kept as its own loop on purpose: one template for
   // both (add_forces<bool>) gave the same bits but cost 1.1-1.8% of a Random2D P2 run, 6.8% with
-  // the energy summed in a local (farm-bench, 3 pairs each, 2026-11-27); this is the hot path.
+  // the energy summed in a local (whole processes timed in alternating pairs, 3 each, 2026-11-27); this is the hot path.
   bool add_energy_residual(const Space& s, const PetscScalar* u, double& energy, PetscScalar* r) const override {
     return detail::dispatch(s, [&]<int D, int NB>() {
       const auto& k = kernel<D>();
