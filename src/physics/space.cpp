@@ -498,8 +498,10 @@ void cell_pattern(PetscInt n, PetscInt n_cells, int nd, const PetscInt* gdofs, s
   std::vector<PetscInt> start(std::size_t(n) + 1, 0);
   const auto dof = [&](PetscInt c, int i) { return gdofs[std::size_t(c) * std::size_t(nd) + std::size_t(i)]; };
   for (PetscInt c = 0; c < n_cells; ++c)
-    for (int i = 0; i < nd; ++i)
+    for (int i = 0; i < nd; ++i) {
+      if (dof(c, i) >= n) throw std::logic_error("cell_pattern: a cell's dof is not a local row");
       if (dof(c, i) >= 0) ++start[std::size_t(dof(c, i)) + 1];
+    }
   for (std::size_t r = 0; r < std::size_t(n); ++r) start[r + 1] += start[r];
   std::vector<PetscInt> cells(std::size_t(start.back())), fill(start.begin(), start.end() - 1);
   for (PetscInt c = 0; c < n_cells; ++c)
