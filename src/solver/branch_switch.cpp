@@ -194,12 +194,7 @@ void NonlinearSolver::switch_branch(double target, double start, int attempt, Ta
   }
   // On the new branch: a stable equilibrium at the same load. Follow it to the target.
   TargetResult p = follow_path(target, start, t.newton_iterations);
-  p.solves += t.solves;
-  p.newton_iterations += t.newton_iterations;
-  p.failed_increments += t.failed_increments;
-  p.off_path_increments += t.off_path_increments;
-  p.increments += t.increments;
-  p.recovery_iterations += t.recovery_iterations;
+  p.add_earlier(t, false);
   p.reason = p.converged ? "target reached after a branch switch (" + before + ")"
                          : p.reason + " (after a branch switch from: " + before + ")";
   t = p;

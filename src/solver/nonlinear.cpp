@@ -49,7 +49,7 @@ NonlinearSolver::NonlinearSolver(const physics::Problem& problem, const SolverOp
   u_ = problem.create_vector();
   backup_ = problem.create_vector();
   r_ = problem.create_vector();
-  for (core::VecH* v : {&a_, &a0_, &b_, &c_, &du_, &w_, &v_, &v0_}) *v = problem.create_vector();
+  for (core::VecH* v : {&a_, &a0_, &b_, &c_, &du_, &w_, &v_, &v0_, &arc_dir_, &arc_prev_dir_}) *v = problem.create_vector();
   HS_PETSC(SNESCreate(comm, snes_.out()));
   if (!prefix.empty()) HS_PETSC(SNESSetOptionsPrefix(snes_, prefix.c_str()));
   // No SNESSetDM: SNES callbacks live on the DM's DMSNES, so solvers sharing the problem's DM
@@ -219,18 +219,22 @@ TargetResult NonlinearSolver::solve_for_target(double target) {
                t.reason.substr(0, 400) + ")";
   if (!t.converged && !problem_.conservative() && opt_.branch_switches > 0 && opt_.control == Control::displacement)
     t.reason += "; no branch switch: a follower load has no energy to minimise";
+  if (opt_.arc_length_rescue && problem_.space().dim() == 2 && opt_.control == Control::displacement && !t.converged &&
+      target > 0 && t.solves > 0 && problem_.conservative() && !problem_.has_fixed_load() &&
+      first.rfind("fold:", 0) != 0) {
+    const TargetResult before = t;
+    t = arc_path(target, start);
+    t.add_earlier(before, true);
+    t.reason = t.converged ? "target reached by arc-length continuation (before: " + before.reason.substr(0, 400) + ")"
+                           : before.reason.substr(0, 400) + "; arc-length continuation: " + t.reason;
+  }
   if (opt_.control == Control::displacement && !t.converged && opt_.fallback && target > 0) {
     // Fallback, measured on Random2D draws: where the path cannot be followed (Newton stalls
     // next to a bifurcation), load-controlled solves from the last converged state of the
     // path may still reach a stable equilibrium at the target (a buckled one).
     const TargetResult path = t;
     t = search_target(target, start);
-    t.solves += path.solves;
-    t.newton_iterations += path.newton_iterations;
-    t.failed_increments += path.failed_increments;
-    t.off_path_increments += path.off_path_increments;
-    t.increments += path.increments;
-    t.recovery_iterations += path.newton_iterations;
+    t.add_earlier(path, true);
     t.reason = (t.converged ? "target reached by load control" : t.reason) +
                " (displacement control: " + path.reason + ")";
   }

@@ -151,6 +151,14 @@ double NonlinearSolver::control_direction(Vec u, Vec fallback, Vec c) {
   return cu;  // = max|u| (0 when u = 0)
 }
 
+double NonlinearSolver::constraint(Vec u, Vec fallback, Vec c) {
+  if (!arc_) return control_direction(u, fallback, c);
+  HS_PETSC(VecCopy(arc_dir_, c));
+  PetscReal cu;
+  HS_PETSC(VecDot(c, u, &cu));
+  return cu - arc_offset_;
+}
+
 bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why) {
   LogEvent event(events().corrector);
   const double fnorm = problem_.load_norm();
@@ -168,7 +176,7 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
   constexpr double eta_path = 0.1;
   tangent_->set_forcing(rtol > opt_.rtol ? std::max(eta_path, opt_.tangent.krylov_rtol) : opt_.tangent.krylov_rtol);
   for (int k = 0;; ++k) {
-    const double m = control_direction(u_, a_, c_);
+    const double m = constraint(u_, a_, c_);
     const double g = m - d;
     if (!std::isfinite(rn)) {
       why = "non-finite residual";
@@ -215,8 +223,9 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
     HS_PETSC(VecAXPBYPCZ(du_, 1.0, -dalpha, 0.0, b_, a_));  // Y = -du = b - dalpha a
     HS_PETSC(VecAXPY(r_, -dalpha, problem_.load_at(u_)));  // R(u, s + dalpha)
     const double lambda = backtrack(u_, du_, r_, s_full, w_, b_);
-    HS_PETSC(PetscInfo(snes_.get(), "corrector %d: |R| %g (%g to go), |u_k| - d %g, dalpha %g, step %g, %d negative pivots\n", k, rn,
-                       rn / (opt_.atol + rtol * std::abs(s_) * fnorm), g, dalpha, lambda, negative_pivots_));
+    HS_PETSC(PetscInfo(snes_.get(), "corrector %d: |R| %g (%g to go), |u_k| - d %g, dalpha %g (c.a %g, c.b %g), step %g, %d negative pivots\n",
+                       k, rn, rn / (opt_.atol + rtol * std::abs(s_) * fnorm), g, dalpha, double(ca), double(cb), lambda,
+                       negative_pivots_));
     if (lambda == 0.0) {
       why = "line search found no admissible decrease";
       return false;
@@ -285,7 +294,7 @@ bool NonlinearSolver::predict(double d_next, std::string& why) {
   // state, and damped where a linearised large rotation would stretch a nearly
   // incompressible body. (Shortening the increment to the damped length instead cost more
   // increments than it saved: measured on Random2D draws.)
-  const double m = control_direction(u_, a_, c_);
+  const double m = constraint(u_, a_, c_);
   PetscReal ca;
   HS_PETSC(VecDot(c_, a_, &ca));
   // c . a = d max|u| / d alpha along the path; negative past a limit point of the load (the
@@ -508,6 +517,107 @@ TargetResult NonlinearSolver::path(double target, double start, int spent, PathS
   t.newton_iterations = its - spent;
   finish_path(t, d == target);
   return t;
+}
+
+TargetResult NonlinearSolver::arc_path(double target, double start) {
+  TargetResult t;
+  int its = 0;
+  HS_PETSC(VecZeroEntries(u_));
+  s_ = 0;
+  std::string why = "tangent factorisation or solve failed at rest";
+  PetscReal an = 0;
+  const bool ready = rest_response();
+  if (ready) HS_PETSC(VecNorm(a_, NORM_2, &an));
+  const double amax = ready ? problem_.max_displacement(a_) : 0.0;
+  if (!(an > 0) || !(amax > 0) || !std::isfinite(an)) {
+    t.reason = why;
+    return t;
+  }
+  // Lengths along the path are measured in |u|_2; a step of `scale` moves max|u| by about one
+  // unit at the start. The first increment: an eighth of the target's max|u|.
+  const double scale = an / amax;
+  double step = 0.125 * target * scale;
+  const double min_step = 1e-3 * target * scale;
+  HS_PETSC(VecAXPBY(arc_dir_, 1.0 / an, 0.0, a_));
+  arc_ = true;
+  int failed_in_a_row = 0;
+  bool crossed = false, landing = false;
+  while (true) {
+    if (its >= opt_.newton_budget) {
+      why = "Newton budget of " + std::to_string(opt_.newton_budget) + " iterations spent";
+      break;
+    }
+    if (t.solves >= 4 * opt_.max_increments) {
+      why = "too many increments (last: " + why + ")";
+      break;
+    }
+    HS_PETSC(VecCopy(u_, backup_));
+    HS_PETSC(VecCopy(a_, a0_));
+    HS_PETSC(VecCopy(arc_dir_, arc_prev_dir_));
+    const double s_backup = s_;
+    PetscReal offset;
+    HS_PETSC(VecDot(arc_dir_, u_, &offset));
+    arc_offset_ = offset;
+    const int its_before = its;
+    ++t.solves;
+    may_leave_ = failed_in_a_row == 0;
+    const bool ok = increment(step, false, its, why);
+    HS_PETSC(PetscInfo(snes_.get(), "arc-length: step %g: %s in %d Newton its (alpha %g, max|u| %g)\n", step,
+                       ok ? "converged" : why.c_str(), its - its_before, s_, problem_.max_displacement(u_)));
+    if (!ok) {
+      ++t.failed_increments;
+      t.recovery_iterations += its - its_before;
+      HS_PETSC(VecCopy(backup_, u_));
+      HS_PETSC(VecCopy(a0_, a_));
+      s_ = s_backup;
+      step *= 0.5;
+      if (++failed_in_a_row == opt_.max_halvings || step < min_step) {
+        why = std::to_string(failed_in_a_row) + " failed increments in a row (last: " + why + ")";
+        break;
+      }
+      continue;
+    }
+    ++t.increments;
+    failed_in_a_row = 0;
+    const double m = problem_.max_displacement(u_);
+    if (m >= target && s_ > 0) {
+      // Past the target: where it overshot by more than a quarter of this increment's rise in
+      // max|u|, the increment again, shortened to end just past the target (the way back under
+      // displacement control is then short).
+      const double m0 = problem_.max_displacement(backup_);
+      if (!landing && m - target > 0.25 * (m - m0) && m > m0) {
+        landing = true;
+        HS_PETSC(VecCopy(backup_, u_));
+        HS_PETSC(VecCopy(a0_, a_));
+        s_ = s_backup;
+        step *= std::min(1.0, 1.1 * (target - m0) / (m - m0));
+        HS_PETSC(VecCopy(arc_prev_dir_, arc_dir_));
+        continue;
+      }
+      crossed = true;
+      break;
+    }
+    landing = false;
+    // The next direction: the secant of this increment (it goes on along the path where max|u|
+    // turns back or the load passes a limit point).
+    HS_PETSC(VecWAXPY(arc_dir_, -1.0, backup_, u_));
+    PetscReal len;
+    HS_PETSC(VecNormalize(arc_dir_, &len));
+    step = next_step(step, its - its_before);
+  }
+  arc_ = false;
+  if (!crossed) {
+    t.reason = why;
+    t.newton_iterations = its;
+    t.max_displacement = problem_.max_displacement(u_);
+    t.alpha = s_;
+    return t;
+  }
+  // max|u| passed the target on this increment: back to it under displacement control.
+  t.newton_iterations = its;
+  TargetResult p = path(target, start, its, PathStart::here);
+  p.add_earlier(t, false);
+  return p;
 }
 
 }  // namespace hypershape::solver
