@@ -501,9 +501,7 @@ TargetResult NonlinearSolver::path(double target, double start, int spent, PathS
     ++t.failed_increments;
     t.off_path_increments += left_path_;
     t.recovery_iterations += its - its_before;
-    HS_PETSC(VecCopy(backup_, u_));
-    HS_PETSC(VecCopy(a0_, a_));
-    s_ = s_backup;
+    restore_increment(s_backup);
     step = 0.5 * (d_next - d);  // half the increment that failed (step may have been longer)
     if (how == PathStart::rest_once && first_accepted) {
       t.reason = "first increment from rest failed (" + why + ")";
@@ -519,26 +517,37 @@ TargetResult NonlinearSolver::path(double target, double start, int spent, PathS
   return t;
 }
 
+double NonlinearSolver::arc_start() {
+  HS_PETSC(VecZeroEntries(u_));
+  s_ = 0;
+  PetscReal an = 0;
+  if (!rest_response()) return 0;
+  HS_PETSC(VecNorm(a_, NORM_2, &an));
+  const double amax = problem_.max_displacement(a_);
+  if (!(an > 0) || !(amax > 0) || !std::isfinite(an)) return 0;
+  HS_PETSC(VecAXPBY(arc_dir_, 1.0 / an, 0.0, a_));
+  return an / amax;
+}
+
+void NonlinearSolver::restore_increment(double s) {
+  HS_PETSC(VecCopy(backup_, u_));
+  HS_PETSC(VecCopy(a0_, a_));
+  s_ = s;
+}
+
 TargetResult NonlinearSolver::arc_path(double target, double start) {
   TargetResult t;
   int its = 0;
-  HS_PETSC(VecZeroEntries(u_));
-  s_ = 0;
-  std::string why = "tangent factorisation or solve failed at rest";
-  PetscReal an = 0;
-  const bool ready = rest_response();
-  if (ready) HS_PETSC(VecNorm(a_, NORM_2, &an));
-  const double amax = ready ? problem_.max_displacement(a_) : 0.0;
-  if (!(an > 0) || !(amax > 0) || !std::isfinite(an)) {
-    t.reason = why;
-    return t;
-  }
+  std::string why;
   // Lengths along the path are measured in |u|_2; a step of `scale` moves max|u| by about one
   // unit at the start. The first increment: an eighth of the target's max|u|.
-  const double scale = an / amax;
+  const double scale = arc_start();
+  if (!(scale > 0)) {
+    t.reason = "tangent factorisation or solve failed at rest";
+    return t;
+  }
   double step = 0.125 * target * scale;
   const double min_step = 1e-3 * target * scale;
-  HS_PETSC(VecAXPBY(arc_dir_, 1.0 / an, 0.0, a_));
   arc_ = true;
   int failed_in_a_row = 0;
   bool crossed = false, landing = false;
@@ -567,9 +576,7 @@ TargetResult NonlinearSolver::arc_path(double target, double start) {
     if (!ok) {
       ++t.failed_increments;
       t.recovery_iterations += its - its_before;
-      HS_PETSC(VecCopy(backup_, u_));
-      HS_PETSC(VecCopy(a0_, a_));
-      s_ = s_backup;
+      restore_increment(s_backup);
       step *= 0.5;
       if (++failed_in_a_row == opt_.max_halvings || step < min_step) {
         why = std::to_string(failed_in_a_row) + " failed increments in a row (last: " + why + ")";
@@ -587,9 +594,7 @@ TargetResult NonlinearSolver::arc_path(double target, double start) {
       const double m0 = problem_.max_displacement(backup_);
       if (!landing && m - target > 0.25 * (m - m0) && m > m0) {
         landing = true;
-        HS_PETSC(VecCopy(backup_, u_));
-        HS_PETSC(VecCopy(a0_, a_));
-        s_ = s_backup;
+        restore_increment(s_backup);
         step *= std::min(1.0, 1.1 * (target - m0) / (m - m0));
         HS_PETSC(VecCopy(arc_prev_dir_, arc_dir_));
         continue;

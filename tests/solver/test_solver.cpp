@@ -336,7 +336,8 @@ TEST_CASE("Failed increments are recovered and their cost counted; a spent budge
     INFO(t.reason);
     CHECK_FALSE(t.converged);
     CHECK_THAT(t.reason, Catch::Contains("budget"));
-    CHECK(t.newton_iterations <= 3);
+    // The path (its branch switches included) and the arc-length rescue have a budget each.
+    CHECK(t.newton_iterations <= 2 * o.newton_budget);
     // The state is the last converged one: admissible and finite.
     CHECK(p.min_det_f(ns.solution()) > 0);
     CHECK(hstest::all_finite(hstest::values(ns.solution())));

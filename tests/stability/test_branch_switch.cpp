@@ -35,6 +35,7 @@ TEST_CASE("Branch switching turns lost stability into stable equilibria on targe
 
     solver::SolverOptions off = cfg.solver;
     off.branch_switches = 0;
+    off.arc_length_rescue = false;  // without any recovery after the path
     solver::NonlinearSolver plain(p, off);
     const auto r0 = plain.solve_for_target(lc.target);
     lost_without += !r0.converged && r0.reason.rfind("loss of stability", 0) == 0;

@@ -240,6 +240,11 @@ class NonlinearSolver {
   /// length along the path's direction (the tangent at rest, then the secant of the last
   /// increment) until max|u| passes `target`, then path() from there back to it.
   TargetResult arc_path(double target, double start);
+  /// arc_path's start: u_ = 0, s_ = 0, a_ = K(0)^-1 f_ext, arc_dir_ = a_ / |a_|_2; returns
+  /// |a_|_2 / max|a_| (0 where the response at rest cannot be formed).
+  double arc_start();
+  /// Back to the state an increment started from (backup_, a0_) at load factor s.
+  void restore_increment(double s);
   /// The constraint of the current increment: with arc_ the fixed direction arc_dir_ in c and
   /// c . u - arc_offset_; else control_direction (max|u|). Collective.
   double constraint(Vec u, Vec fallback, Vec c);
