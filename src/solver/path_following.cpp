@@ -13,6 +13,7 @@
 #include "hypershape/core/error.hpp"
 #include "hypershape/core/timer.hpp"
 #include "hypershape/core/vec_array.hpp"
+#include "hypershape/solver/step_control.hpp"
 #include "log_events.hpp"
 
 namespace hypershape::solver {
@@ -48,17 +49,6 @@ std::string unstable_reason(double target, double alpha, int negative, double sl
            num(e.d_at_max) + ", min " + num(e.min_alpha) + " at max|u| = " + num(e.d_at_min) + ")";
   return "loss of stability at max|u| = " + num(target) + ", alpha = " + num(alpha) + ": the tangent has " +
          std::to_string(negative) + " negative eigenvalue(s) (buckling or a bifurcation)";
-}
-
-/// Step control by the corrector's count `n`: double after <= 2 iterations, halve after >= 6.
-/// Measured on Random2D (8 x 25, P1): the increment after a doubling failed in 13%, 11% and 18%
-/// of cases after 1, 2 and 3 iterations (a failure costs 5.7 iterations, an accepted
-/// intermediate increment 3.1); doubling after <= 3 and halving after >= 8 (before): 13.3 Newton
-/// iterations per load case, this rule 12.6 (0.24 failed increments per load case against
-/// 0.34), all 200 converged.
-double next_step(double step, int n) {
-  if (n <= 2) return 2.0 * step;
-  return n >= 6 ? 0.5 * step : step;
 }
 
 /// Why the path gives up after a failed increment (none: it goes on with the halved `step`).
@@ -170,6 +160,7 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
   PetscReal rn, rn0;
   HS_PETSC(VecNorm(r_, NORM_2, &rn));
   rn0 = rn;
+  CreepWatch creep(rn);
   // Intermediate states of the path are converged loosely (path_rtol), and so are their Krylov
   // solves: forcing 0.1 there (against krylov_rtol, 1e-3, throughout) cut the factorisations
   // by a third and the Newton iterations by 3% on Random2D draws (3 shapes x 20 load cases).
@@ -196,6 +187,10 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
     }
     if (k >= 4 && rn > rn0) {  // quadratic convergence would be far along by now
       why = "no progress in " + std::to_string(k) + " Newton iterations";
+      return false;
+    }
+    if (creep.creeping()) {
+      why = "Newton creeping (3 steps cut below 0.3 by the line search, |R| not halved)";
       return false;
     }
     if (its >= opt_.newton_budget) {
@@ -240,6 +235,7 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
     s_ += lambda * dalpha;
     HS_PETSC(VecWAXPY(r_, (1.0 - lambda) * dalpha, problem_.load_at(u_), b_));  // R(w, s_)
     HS_PETSC(VecNorm(r_, NORM_2, &rn));
+    creep.step(lambda, rn);
   }
 }
 

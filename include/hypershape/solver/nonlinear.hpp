@@ -35,7 +35,8 @@
 ///     alpha + dalpha and goes through the same guarded energy line search (never a state with
 ///     det F <= 0), alpha moving by the same fraction; intermediate increments are converged
 ///     to path_rtol only, the last to rtol;
-///   - an increment that fails (max_newton iterations, no progress after 4, or, with
+///   - an increment that fails (max_newton iterations, no progress after 4, Newton creeping:
+///     three steps cut below 0.3 by the line search without halving |R|, or, with
 ///     abandon_off_path, an iterate that left the path: off_the_path) is discarded,
 ///     the state restored and the increment halved; after an easy success (<= 2 iterations) it
 ///     doubles, after a hard one (>= 6) it halves (FEBio-style); an intermediate increment
