@@ -12,7 +12,9 @@
 # now writes the former preset out (only its stored config text was updated), and preset_r3m
 # is the preset itself, fingerprinted when it moved. On 2026-11-26 it moved again (surface 0.22,
 # interior 0.3, rim 0.125, single-precision factors): preset_r3m writes the 2026-11-25 preset
-# out, and preset_r3s is the preset, fingerprinted when it moved.
+# out, and preset_r3s is the preset, fingerprinted when it moved. On 2026-11-27 the corrector
+# began to give up a creeping increment (CreepWatch, issue 23): r2's shape 0, load 0 takes one
+# Newton iteration fewer (newton_iterations and recovery_iterations updated; u unchanged).
 # Needs HYPERSHAPE_BIN and HYPERSHAPE_SOURCE_DIR (set by CTest).
 . "$(dirname "$0")/lib.sh"
 for name in r2 e2 r3 r3m r3s; do

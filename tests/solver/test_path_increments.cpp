@@ -5,6 +5,8 @@
 /// refreshed its tangent.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <initializer_list>
+#include <utility>
 
 #include "hypershape/solver/nonlinear.hpp"
 #include "hypershape/solver/step_control.hpp"
@@ -59,33 +61,30 @@ TEST_CASE("The path's increments end in the equilibrium a Newton solve at the sa
   CHECK(failed <= 10);
 }
 
+namespace {
+
+/// Whether a corrector that started at |R| = rn0 and took `steps` (length of Newton's, |R| after) creeps.
+bool creeps(double rn0, std::initializer_list<std::pair<double, double>> steps) {
+  solver::CreepWatch w(rn0);
+  for (const auto& [lambda, rn] : steps) w.step(lambda, rn);
+  return w.creeping();
+}
+
+}  // namespace
+
 TEST_CASE("Step control: doubling, halving, and a creeping corrector given up", "[solver]") {
   CHECK(solver::next_step(0.1, 1) == 0.2);
   CHECK(solver::next_step(0.1, 2) == 0.2);
   CHECK(solver::next_step(0.1, 4) == 0.1);
   CHECK(solver::next_step(0.1, 6) == 0.05);
   // Three steps cut below 0.3 that leave |R| above half of what it was: creeping.
-  solver::CreepWatch a(10.0);
-  a.step(0.1, 9.0);
-  a.step(0.05, 8.0);
-  CHECK_FALSE(a.creeping());  // only two steps yet
-  a.step(0.2, 7.0);
-  CHECK(a.creeping());
+  CHECK_FALSE(creeps(10, {{0.1, 9}, {0.05, 8}}));  // only two steps yet
+  CHECK(creeps(10, {{0.1, 9}, {0.05, 8}, {0.2, 7}}));
   // The same residuals after a whole step among the three: Newton is not creeping.
-  solver::CreepWatch b(10.0);
-  b.step(0.1, 9.0);
-  b.step(1.0, 8.0);
-  b.step(0.2, 7.0);
-  CHECK_FALSE(b.creeping());
-  b.step(0.1, 6.5);
-  b.step(0.1, 6.0);
-  CHECK(b.creeping());  // the window slides: the last three were cut, 6.0 > 0.5 x 8.0
-  // Cut steps that halve |R| over the window are progress.
-  solver::CreepWatch c(10.0);
-  c.step(0.1, 8.0);
-  c.step(0.1, 6.0);
-  c.step(0.1, 4.9);
-  CHECK_FALSE(c.creeping());
-  c.step(0.1, 4.1);
-  CHECK(c.creeping());  // 4.1 > 0.5 x 8.0
+  CHECK_FALSE(creeps(10, {{0.1, 9}, {1.0, 8}, {0.2, 7}}));
+  // The window slides: the last three were cut, and 6.0 > 0.5 x 8.0.
+  CHECK(creeps(10, {{0.1, 9}, {1.0, 8}, {0.2, 7}, {0.1, 6.5}, {0.1, 6}}));
+  // Cut steps that halve |R| over the window are progress; the next one that does not is not.
+  CHECK_FALSE(creeps(10, {{0.1, 8}, {0.1, 6}, {0.1, 4.9}}));
+  CHECK(creeps(10, {{0.1, 8}, {0.1, 6}, {0.1, 4.9}, {0.1, 4.1}}));
 }
