@@ -190,7 +190,7 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
       return false;
     }
     if (creep.creeping()) {
-      why = "Newton creeping (3 steps cut below 0.3 by the line search, |R| not halved)";
+      why = CreepWatch::reason;
       return false;
     }
     if (its >= opt_.newton_budget) {

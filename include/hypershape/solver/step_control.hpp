@@ -27,6 +27,9 @@ class CreepWatch {
   static constexpr int window = 3;           ///< steps looked at
   static constexpr double cut = 0.3;         ///< a step shorter than this fraction of Newton's is cut
   static constexpr double reduction = 0.5;   ///< |R| must fall below this factor over the window
+  /// Why the increment failed (the reason a load case records when it was its last failure).
+  static constexpr const char* reason =
+      "Newton creeping (3 steps cut below 0.3 by the line search, |R| not halved)";
 
   explicit CreepWatch(double rn) { rn_[0] = rn; }
   /// A step of `lambda` times Newton's taken, leaving the residual norm `rn`.
