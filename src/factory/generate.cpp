@@ -297,8 +297,8 @@ void reduce_report(MPI_Comm comm, bool group_root, const core::PhaseTimes& times
   {
     PetscLogEvent ev;
     PetscEventPerfInfo info{};
-    // PETSc's factorisations are PCSetUp; the single-precision ones (SMUMPS) are not.
-    for (const char* name : {"PCSetUp", "HSFactorSingle"})
+    // PETSc's factorisations are PCSetUp; the single-precision (SMUMPS) and the 2D blocked ones are not.
+    for (const char* name : {"PCSetUp", "HSFactorSingle", "HSFactorBlocked"})
       if (PetscLogEventGetId(name, &ev) == 0 && PetscLogEventGetPerfInfo(0, ev, &info) == 0) pc_setup += info.time;
   }
   // Counters: the group roots hold the group's numbers once.

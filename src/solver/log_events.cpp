@@ -20,6 +20,7 @@ const Events& events() {
     HS_PETSC(PetscLogEventRegister("HSAMGSetup", cls, &r.multigrid_setup));
     HS_PETSC(PetscLogEventRegister("HSStability", cls, &r.stability));
     HS_PETSC(PetscLogEventRegister("HSFactorSingle", cls, &r.single_factor));
+    HS_PETSC(PetscLogEventRegister("HSFactorBlocked", cls, &r.blocked_factor));
     return r;
   }();
   return e;

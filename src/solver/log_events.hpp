@@ -4,14 +4,15 @@
 /// the first), HSFactorSolve (direct solves with a factor), HSKrylov (Newton-Krylov solves),
 /// HSPredictor / HSCorrector (the displacement-controlled path), HSBranchSwitch, HSLoadControl,
 /// HSAMGSetup (multigrid set-ups of a tangent), HSStability (the multigrid kind's LOBPCG check),
-/// HSFactorSingle (numeric single-precision factorisations, SMUMPS: not a PCSetUp).
+/// HSFactorSingle (numeric single-precision factorisations, SMUMPS: not a PCSetUp),
+/// HSFactorBlocked (numeric factorisations of the 2D blocked LDL^T, BlockLdlt2: not a PCSetUp).
 #include <petsclog.h>
 
 namespace hypershape::solver {
 
 struct Events {
   PetscLogEvent tangent_assembly, factorisation, factor_solve, krylov, predictor, corrector,
-      branch_switch, load_control, multigrid_setup, stability, single_factor;
+      branch_switch, load_control, multigrid_setup, stability, single_factor, blocked_factor;
 };
 
 /// Registered on first use (PETSc must be initialised). Not collective.

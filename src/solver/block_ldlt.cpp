@@ -1,0 +1,175 @@
+#include "hypershape/solver/block_ldlt.hpp"
+
+#include <petsc/private/kernels/blockinvert.h>
+
+#include <algorithm>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+#include "hypershape/core/error.hpp"
+
+namespace hypershape::solver {
+
+namespace {
+
+/// Two doubles, one SSE register: every operation on it is one IEEE operation per lane.
+using V2 = double __attribute__((vector_size(16)));
+
+inline V2 load(const double* p) {
+  V2 v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+inline void store(double* p, V2 v) { std::memcpy(p, &v, sizeof v); }
+
+/// row[col[j]] += the 2x2 product of the multiplier m and block j of one row of U (u, blocks
+/// column-major), for j in [0, n), entry by entry in the order of PETSc's scalar kernel:
+///   r0 += m0 u0 + m1 u1, r1 += m2 u0 + m3 u1, r2 += m0 u2 + m1 u3, r3 += m2 u2 + m3 u3.
+/// p = (m0, m2), q = (m1, m3).
+inline void add_row(double* row, V2 p, V2 q, const double* u, const PetscInt* col, PetscInt n) {
+  for (PetscInt j = 0; j < n; ++j, u += 4) {
+    double* r = row + 4 * col[j];
+    store(r, load(r) + (p * u[0] + q * u[1]));
+    store(r + 2, load(r + 2) + (p * u[2] + q * u[3]));
+  }
+}
+
+}  // namespace
+
+void BlockLdlt2::analyse(PetscInt nb, const PetscInt* rows, const PetscInt* cols) {
+  nb_ = nb;
+  ai_.assign(rows, rows + nb + 1);
+  aj_.assign(cols, cols + rows[nb]);
+  // Row k of U: the columns > k of A's row k and of U's rows whose first column is k (k's
+  // children in the elimination tree), merged and sorted.
+  std::vector<PetscInt> child_head(std::size_t(nb), -1), child_next(std::size_t(nb), -1), mark(std::size_t(nb), -1);
+  std::vector<PetscInt> row;
+  ui_.assign(std::size_t(nb) + 1, 0);
+  uj_.clear();
+  auto add = [&](PetscInt k, PetscInt c) {
+    if (c > k && mark[std::size_t(c)] != k) mark[std::size_t(c)] = k, row.push_back(c);
+  };
+  for (PetscInt k = 0; k < nb; ++k) {
+    row.clear();
+    if (ai_[std::size_t(k)] == ai_[std::size_t(k) + 1] || aj_[std::size_t(ai_[std::size_t(k)])] != k)
+      throw std::invalid_argument("BlockLdlt2: block row " + std::to_string(k) + " has no diagonal block first");
+    for (PetscInt j = ai_[std::size_t(k)]; j < ai_[std::size_t(k) + 1]; ++j) add(k, aj_[std::size_t(j)]);
+    for (PetscInt c = child_head[std::size_t(k)]; c >= 0; c = child_next[std::size_t(c)])
+      for (PetscInt p = ui_[std::size_t(c)]; p < ui_[std::size_t(c) + 1]; ++p) add(k, uj_[std::size_t(p)]);
+    std::sort(row.begin(), row.end());
+    uj_.insert(uj_.end(), row.begin(), row.end());
+    ui_[std::size_t(k) + 1] = PetscInt(uj_.size());
+    if (!row.empty()) {
+      child_next[std::size_t(k)] = child_head[std::size_t(row[0])];
+      child_head[std::size_t(row[0])] = k;
+    }
+  }
+  d_.assign(4 * std::size_t(nb), 0.0);
+  u_.assign(4 * uj_.size(), 0.0);
+  row_.assign(4 * std::size_t(nb), 0.0);
+  next_.assign(std::size_t(nb), nb);
+  first_.assign(std::size_t(nb), 0);
+}
+
+bool BlockLdlt2::factorise(const PetscScalar* a) {
+  // PETSc's default for its factorisations (PCFactor): an exactly zero first pivot of a 2x2
+  // block is replaced by a tiny shift; a zero second pivot fails.
+  const PetscReal shift = 100.0 * PETSC_MACHINE_EPSILON;
+  std::fill(next_.begin(), next_.end(), nb_);
+  bool ok = true;
+  for (PetscInt k = 0; k < nb_; ++k) {
+    // Row k of A into the dense work row (zero elsewhere: each row is cleared as it is stored).
+    for (PetscInt j = ai_[std::size_t(k)]; j < ai_[std::size_t(k) + 1]; ++j)
+      std::memcpy(&row_[4 * std::size_t(aj_[std::size_t(j)])], a + 4 * j, 4 * sizeof(double));
+    double dk[4];
+    std::memcpy(dk, &row_[4 * std::size_t(k)], sizeof dk);
+    // Rows i < k with U(i, k) != 0, in the order they were linked: U(i, k) becomes
+    // m = -D_i^-1 U(i, k), D_k += m^T-weighted U(i, k), row k += m U(i, k+1:).
+    for (PetscInt i = next_[std::size_t(k)]; i < k;) {
+      const PetscInt after = next_[std::size_t(i)];
+      if (after < k) {  // the next row's blocks are scattered in memory: ask for them early
+        __builtin_prefetch(&u_[4 * std::size_t(first_[std::size_t(after)])]);
+        __builtin_prefetch(&d_[4 * std::size_t(after)]);
+      }
+      const PetscInt f = first_[std::size_t(i)];
+      const double* di = &d_[4 * std::size_t(i)];
+      double* uik = &u_[4 * std::size_t(f)];
+      const double u0 = uik[0], u1 = uik[1], u2 = uik[2], u3 = uik[3];
+      const double m0 = -(di[0] * u0 + di[2] * u1), m1 = -(di[1] * u0 + di[3] * u1),
+                   m2 = -(di[0] * u2 + di[2] * u3), m3 = -(di[1] * u2 + di[3] * u3);
+      dk[0] += m0 * u0 + m1 * u1;
+      dk[1] += m2 * u0 + m3 * u1;
+      dk[2] += m0 * u2 + m1 * u3;
+      dk[3] += m2 * u2 + m3 * u3;
+      uik[0] = m0, uik[1] = m1, uik[2] = m2, uik[3] = m3;  // (m in registers: no copy through memory)
+      const PetscInt start = f + 1, end = ui_[std::size_t(i) + 1];
+      if (start < end) {
+        add_row(row_.data(), V2{m0, m2}, V2{m1, m3}, &u_[4 * std::size_t(start)], &uj_[std::size_t(start)], end - start);
+        first_[std::size_t(i)] = start;  // row i joins the list of its next column
+        const PetscInt c = uj_[std::size_t(start)];
+        next_[std::size_t(i)] = next_[std::size_t(c)];
+        next_[std::size_t(c)] = i;
+      }
+      i = after;
+    }
+    double* dinv = &d_[4 * std::size_t(k)];
+    std::memcpy(dinv, dk, sizeof dk);
+    PetscBool zero = PETSC_FALSE;
+    HS_PETSC(PetscKernel_A_gets_inverse_A_2(dinv, shift, PETSC_TRUE, &zero));
+    if (zero) ok = false;  // go on: the work row must end cleared
+    const PetscInt start = ui_[std::size_t(k)], end = ui_[std::size_t(k) + 1];
+    for (PetscInt p = start; p < end; ++p) {
+      double* r = &row_[4 * std::size_t(uj_[std::size_t(p)])];
+      std::memcpy(&u_[4 * std::size_t(p)], r, 4 * sizeof(double));
+      std::fill(r, r + 4, 0.0);
+    }
+    if (start < end) {
+      first_[std::size_t(k)] = start;
+      const PetscInt c = uj_[std::size_t(start)];
+      next_[std::size_t(k)] = next_[std::size_t(c)];
+      next_[std::size_t(c)] = k;
+    }
+  }
+  return ok;
+}
+
+void BlockLdlt2::solve(PetscScalar* x) const {
+  // U^T D y = b forward (D^-1 applied as each block row is finished), then U x = y backward.
+  for (PetscInt k = 0; k < nb_; ++k) {
+    const double x0 = x[2 * k], x1 = x[2 * k + 1];
+    for (PetscInt p = ui_[std::size_t(k)]; p < ui_[std::size_t(k) + 1]; ++p) {
+      const double* v = &u_[4 * std::size_t(p)];
+      double* y = x + 2 * uj_[std::size_t(p)];
+      const V2 v01 = load(v), v23 = load(v + 2);
+      const V2 a = __builtin_shuffle(v01, v23, (__attribute__((vector_size(16))) long){0, 2});  // v0, v2
+      const V2 b = __builtin_shuffle(v01, v23, (__attribute__((vector_size(16))) long){1, 3});  // v1, v3
+      store(y, load(y) + (a * x0 + b * x1));
+    }
+    const double* d = &d_[4 * std::size_t(k)];
+    store(x + 2 * k, load(d) * x0 + load(d + 2) * x1);
+  }
+  for (PetscInt k = nb_ - 1; k >= 0; --k) {
+    V2 xk = load(x + 2 * k);
+    for (PetscInt p = ui_[std::size_t(k)]; p < ui_[std::size_t(k) + 1]; ++p) {
+      const double* v = &u_[4 * std::size_t(p)];
+      const double* y = x + 2 * uj_[std::size_t(p)];
+      xk += load(v) * y[0] + load(v + 2) * y[1];
+    }
+    store(x + 2 * k, xk);
+  }
+}
+
+int BlockLdlt2::negative_eigenvalues() const {
+  // D_k^-1 has the inertia of D_k; its symmetric part's determinant and diagonal give it.
+  int neg = 0;
+  for (PetscInt k = 0; k < nb_; ++k) {
+    const double* v = &d_[4 * std::size_t(k)];
+    const double a = v[0], b = 0.5 * (v[1] + v[2]), d = v[3];
+    const double det = a * d - b * b;
+    neg += det < 0 ? 1 : (det > 0 && a < 0 ? 2 : 0);
+  }
+  return neg;
+}
+
+}  // namespace hypershape::solver
