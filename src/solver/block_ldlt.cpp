@@ -23,16 +23,95 @@ inline V2 load(const double* p) {
 }
 inline void store(double* p, V2 v) { std::memcpy(p, &v, sizeof v); }
 
+/// Four doubles: one AVX register where the CPU has it, two SSE ones where not; either way one
+/// IEEE operation per lane (no fused multiply-add: the same numbers on every x86-64 machine).
+using V4 = double __attribute__((vector_size(32)));
+using Lanes = long long __attribute__((vector_size(32)));
+
+/// The factor's arrays, for the elimination below (BlockLdlt2's members).
+struct Arrays {
+  PetscInt nb;
+  const PetscInt *ai, *aj, *ui, *uj;
+  double *d, *u, *row;
+  PetscInt *next, *first;
+};
+
 /// row[col[j]] += the 2x2 product of the multiplier m and block j of one row of U (u, blocks
 /// column-major), for j in [0, n), entry by entry in the order of PETSc's scalar kernel:
 ///   r0 += m0 u0 + m1 u1, r1 += m2 u0 + m3 u1, r2 += m0 u2 + m1 u3, r3 += m2 u2 + m3 u3.
-/// p = (m0, m2), q = (m1, m3).
-inline void add_row(double* row, V2 p, V2 q, const double* u, const PetscInt* col, PetscInt n) {
+[[gnu::always_inline]] inline void add_row(double* row, double m0, double m1, double m2, double m3, const double* u,
+                                           const PetscInt* col, PetscInt n) {
+  const V4 p = {m0, m2, m0, m2}, q = {m1, m3, m1, m3};
   for (PetscInt j = 0; j < n; ++j, u += 4) {
     double* r = row + 4 * col[j];
-    store(r, load(r) + (p * u[0] + q * u[1]));
-    store(r + 2, load(r + 2) + (p * u[2] + q * u[3]));
+    V4 b, x;  // (copied, not returned: a V4 in a signature would change the ABI without AVX)
+    std::memcpy(&b, u, sizeof b);
+    std::memcpy(&x, r, sizeof x);
+    const V4 even = __builtin_shuffle(b, Lanes{0, 0, 2, 2}), odd = __builtin_shuffle(b, Lanes{1, 1, 3, 3});
+    x += p * even + q * odd;
+    std::memcpy(r, &x, sizeof x);
   }
+}
+
+/// The numeric factorisation (BlockLdlt2::factorise), compiled twice: for AVX2 (without FMA) and
+/// for the baseline, the one the CPU runs chosen at load time. False on a zero pivot.
+[[gnu::target_clones("avx2", "default")]] bool eliminate(const Arrays& f, const PetscScalar* a) {
+  // PETSc's default for its factorisations (PCFactor): an exactly zero first pivot of a 2x2
+  // block is replaced by a tiny shift; a zero second pivot fails.
+  const PetscReal shift = 100.0 * PETSC_MACHINE_EPSILON;
+  std::fill(f.next, f.next + f.nb, f.nb);
+  bool ok = true;
+  for (PetscInt k = 0; k < f.nb; ++k) {
+    // Row k of A into the dense work row (zero elsewhere: each row is cleared as it is stored).
+    for (PetscInt j = f.ai[k]; j < f.ai[k + 1]; ++j) std::memcpy(f.row + 4 * f.aj[j], a + 4 * j, 4 * sizeof(double));
+    double dk[4];
+    std::memcpy(dk, f.row + 4 * k, sizeof dk);
+    // Rows i < k with U(i, k) != 0, in the order they were linked: U(i, k) becomes the
+    // multiplier m = -D_i^-1 U(i, k); D_k and the rest of row k get m times row i.
+    for (PetscInt i = f.next[k]; i < k;) {
+      const PetscInt after = f.next[i];
+      if (after < k) {  // the next row's blocks are scattered in memory: ask for them early
+        __builtin_prefetch(f.u + 4 * f.first[after]);
+        __builtin_prefetch(f.d + 4 * after);
+      }
+      const PetscInt first = f.first[i];
+      const double* di = f.d + 4 * i;
+      double* uik = f.u + 4 * first;
+      const double u0 = uik[0], u1 = uik[1], u2 = uik[2], u3 = uik[3];
+      const double m0 = -(di[0] * u0 + di[2] * u1), m1 = -(di[1] * u0 + di[3] * u1),
+                   m2 = -(di[0] * u2 + di[2] * u3), m3 = -(di[1] * u2 + di[3] * u3);
+      dk[0] += m0 * u0 + m1 * u1;
+      dk[1] += m2 * u0 + m3 * u1;
+      dk[2] += m0 * u2 + m1 * u3;
+      dk[3] += m2 * u2 + m3 * u3;
+      uik[0] = m0, uik[1] = m1, uik[2] = m2, uik[3] = m3;  // (m in registers: no copy through memory)
+      const PetscInt start = first + 1, end = f.ui[i + 1];
+      if (start < end) {
+        add_row(f.row, m0, m1, m2, m3, f.u + 4 * start, f.uj + start, end - start);
+        f.first[i] = start;  // row i joins the list of its next column
+        f.next[i] = f.next[f.uj[start]];
+        f.next[f.uj[start]] = i;
+      }
+      i = after;
+    }
+    double* dinv = f.d + 4 * k;
+    std::memcpy(dinv, dk, sizeof dk);
+    PetscBool zero = PETSC_FALSE;
+    HS_PETSC(PetscKernel_A_gets_inverse_A_2(dinv, shift, PETSC_TRUE, &zero));
+    if (zero) ok = false;  // go on: the work row must end cleared
+    const PetscInt start = f.ui[k], end = f.ui[k + 1];
+    for (PetscInt p = start; p < end; ++p) {
+      double* r = f.row + 4 * f.uj[p];
+      std::memcpy(f.u + 4 * p, r, 4 * sizeof(double));
+      std::fill(r, r + 4, 0.0);
+    }
+    if (start < end) {
+      f.first[k] = start;
+      f.next[k] = f.next[f.uj[start]];
+      f.next[f.uj[start]] = k;
+    }
+  }
+  return ok;
 }
 
 }  // namespace
@@ -73,65 +152,9 @@ void BlockLdlt2::analyse(PetscInt nb, const PetscInt* rows, const PetscInt* cols
 }
 
 bool BlockLdlt2::factorise(const PetscScalar* a) {
-  // PETSc's default for its factorisations (PCFactor): an exactly zero first pivot of a 2x2
-  // block is replaced by a tiny shift; a zero second pivot fails.
-  const PetscReal shift = 100.0 * PETSC_MACHINE_EPSILON;
-  std::fill(next_.begin(), next_.end(), nb_);
-  bool ok = true;
-  for (PetscInt k = 0; k < nb_; ++k) {
-    // Row k of A into the dense work row (zero elsewhere: each row is cleared as it is stored).
-    for (PetscInt j = ai_[std::size_t(k)]; j < ai_[std::size_t(k) + 1]; ++j)
-      std::memcpy(&row_[4 * std::size_t(aj_[std::size_t(j)])], a + 4 * j, 4 * sizeof(double));
-    double dk[4];
-    std::memcpy(dk, &row_[4 * std::size_t(k)], sizeof dk);
-    // Rows i < k with U(i, k) != 0, in the order they were linked: U(i, k) becomes
-    // m = -D_i^-1 U(i, k), D_k += m^T-weighted U(i, k), row k += m U(i, k+1:).
-    for (PetscInt i = next_[std::size_t(k)]; i < k;) {
-      const PetscInt after = next_[std::size_t(i)];
-      if (after < k) {  // the next row's blocks are scattered in memory: ask for them early
-        __builtin_prefetch(&u_[4 * std::size_t(first_[std::size_t(after)])]);
-        __builtin_prefetch(&d_[4 * std::size_t(after)]);
-      }
-      const PetscInt f = first_[std::size_t(i)];
-      const double* di = &d_[4 * std::size_t(i)];
-      double* uik = &u_[4 * std::size_t(f)];
-      const double u0 = uik[0], u1 = uik[1], u2 = uik[2], u3 = uik[3];
-      const double m0 = -(di[0] * u0 + di[2] * u1), m1 = -(di[1] * u0 + di[3] * u1),
-                   m2 = -(di[0] * u2 + di[2] * u3), m3 = -(di[1] * u2 + di[3] * u3);
-      dk[0] += m0 * u0 + m1 * u1;
-      dk[1] += m2 * u0 + m3 * u1;
-      dk[2] += m0 * u2 + m1 * u3;
-      dk[3] += m2 * u2 + m3 * u3;
-      uik[0] = m0, uik[1] = m1, uik[2] = m2, uik[3] = m3;  // (m in registers: no copy through memory)
-      const PetscInt start = f + 1, end = ui_[std::size_t(i) + 1];
-      if (start < end) {
-        add_row(row_.data(), V2{m0, m2}, V2{m1, m3}, &u_[4 * std::size_t(start)], &uj_[std::size_t(start)], end - start);
-        first_[std::size_t(i)] = start;  // row i joins the list of its next column
-        const PetscInt c = uj_[std::size_t(start)];
-        next_[std::size_t(i)] = next_[std::size_t(c)];
-        next_[std::size_t(c)] = i;
-      }
-      i = after;
-    }
-    double* dinv = &d_[4 * std::size_t(k)];
-    std::memcpy(dinv, dk, sizeof dk);
-    PetscBool zero = PETSC_FALSE;
-    HS_PETSC(PetscKernel_A_gets_inverse_A_2(dinv, shift, PETSC_TRUE, &zero));
-    if (zero) ok = false;  // go on: the work row must end cleared
-    const PetscInt start = ui_[std::size_t(k)], end = ui_[std::size_t(k) + 1];
-    for (PetscInt p = start; p < end; ++p) {
-      double* r = &row_[4 * std::size_t(uj_[std::size_t(p)])];
-      std::memcpy(&u_[4 * std::size_t(p)], r, 4 * sizeof(double));
-      std::fill(r, r + 4, 0.0);
-    }
-    if (start < end) {
-      first_[std::size_t(k)] = start;
-      const PetscInt c = uj_[std::size_t(start)];
-      next_[std::size_t(k)] = next_[std::size_t(c)];
-      next_[std::size_t(c)] = k;
-    }
-  }
-  return ok;
+  const Arrays f{nb_, ai_.data(), aj_.data(), ui_.data(), uj_.data(), d_.data(), u_.data(), row_.data(), next_.data(),
+                 first_.data()};
+  return eliminate(f, a);
 }
 
 void BlockLdlt2::solve(PetscScalar* x) const {
