@@ -1,5 +1,7 @@
 #include "hypershape/solver/block_ldlt.hpp"
 
+// PetscKernel_A_gets_inverse_A_2, exported by libpetsc; its header is one of the private ones
+// Debian's petsc-dev installs. Using PETSc's own 2x2 inverse keeps D^-1 PETSc's to the bit.
 #include <petsc/private/kernels/blockinvert.h>
 
 #include <algorithm>
@@ -183,16 +185,17 @@ void BlockLdlt2::solve(PetscScalar* x) const {
   }
 }
 
-int BlockLdlt2::negative_eigenvalues() const {
-  // D_k^-1 has the inertia of D_k; its symmetric part's determinant and diagonal give it.
+int negative_eigenvalues_2x2(const PetscScalar* dinv, PetscInt nb) {
   int neg = 0;
-  for (PetscInt k = 0; k < nb_; ++k) {
-    const double* v = &d_[4 * std::size_t(k)];
-    const double a = v[0], b = 0.5 * (v[1] + v[2]), d = v[3];
+  for (PetscInt k = 0; k < nb; ++k) {
+    const double* v = dinv + 4 * k;
+    const double a = v[0], b = 0.5 * (v[1] + v[2]), d = v[3];  // the block's symmetric part
     const double det = a * d - b * b;
     neg += det < 0 ? 1 : (det > 0 && a < 0 ? 2 : 0);
   }
   return neg;
 }
+
+int BlockLdlt2::negative_eigenvalues() const { return negative_eigenvalues_2x2(d_.data(), nb_); }
 
 }  // namespace hypershape::solver

@@ -18,20 +18,14 @@ namespace hypershape::solver {
 
 namespace {
 
-/// Negative eigenvalues of the 2x2 diagonal blocks of D in PETSc's blocked U^T D U factor: for
-/// 2x2 blocks PETSc 3.18 stores D_k^-1 (same inertia as D_k) as the first n/2 blocks of the
-/// factor's values (column-major), the blocks of U after them.
-int negative_eigenvalues_2x2(Mat F) {
+/// Negative eigenvalues of PETSc's blocked U^T D U factor of 2x2 blocks: PETSc 3.18 stores D_k^-1
+/// as the first n/2 blocks of the factor's values, the blocks of U after them.
+int petsc_negative_eigenvalues_2x2(Mat F) {
   PetscInt n;
   HS_PETSC(MatGetSize(F, &n, nullptr));
   PetscScalar* v;
   HS_PETSC(MatSeqSBAIJGetArray(F, &v));
-  int neg = 0;
-  for (PetscInt k = 0; k < n / 2; ++k) {
-    const double a = v[4 * k], b = 0.5 * (v[4 * k + 1] + v[4 * k + 2]), d = v[4 * k + 3];
-    const double det = a * d - b * b;
-    neg += det < 0 ? 1 : (det > 0 && a < 0 ? 2 : 0);
-  }
+  const int neg = negative_eigenvalues_2x2(v, n / 2);
   HS_PETSC(MatSeqSBAIJRestoreArray(F, &v));
   return neg;
 }
@@ -60,7 +54,7 @@ int negative_eigenvalues(KSP ksp) {
     HS_PETSC(MatMumpsGetInfog(F, 12, &neg));
   } else if (p == MATSOLVERPETSC) {
     HS_PETSC(MatGetBlockSize(F, &bs));
-    if (bs == 2) return negative_eigenvalues_2x2(F);
+    if (bs == 2) return petsc_negative_eigenvalues_2x2(F);
     if (bs == 1) HS_PETSC(MatGetInertia(F, &neg, &zero, &pos));
   }
   return int(neg);

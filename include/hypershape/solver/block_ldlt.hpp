@@ -15,6 +15,11 @@
 
 namespace hypershape::solver {
 
+/// Negative eigenvalues of a block-diagonal D given by its nb inverted 2x2 blocks (4 each,
+/// column-major, as PETSc's blocked factor and BlockLdlt2 store them): a block and its inverse
+/// have the same inertia (Sylvester's law: the matrix's).
+int negative_eigenvalues_2x2(const PetscScalar* dinv, PetscInt nb);
+
 class BlockLdlt2 {
  public:
   /// The upper block pattern of the matrix: rows `nb`, row k's block columns
