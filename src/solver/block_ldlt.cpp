@@ -30,6 +30,9 @@ inline void store(double* p, V2 v) { std::memcpy(p, &v, sizeof v); }
 using V4 = double __attribute__((vector_size(32)));
 using Lanes = long long __attribute__((vector_size(32)));
 
+/// v = p[0..4) (by reference: a V4 passed or returned by value would change the ABI without AVX).
+[[gnu::always_inline]] inline void get(V4& v, const double* p) { std::memcpy(&v, p, sizeof v); }
+
 /// The factor's arrays, for the elimination below (BlockLdlt2's members).
 struct Arrays {
   PetscInt nb;
@@ -116,6 +119,38 @@ struct Arrays {
   return ok;
 }
 
+/// BlockLdlt2::solve2's substitutions, compiled as eliminate() is. Lanes (a0, a1, b0, b1) of a
+/// node; each lane sums as solve() does: y0 += v0 x0 + v1 x1, y1 += v2 x0 + v3 x1 forward,
+/// x0 += v0 y0 + v2 y1, x1 += v1 y0 + v3 y1 backward, D^-1 as d0 x0 + d2 x1, d1 x0 + d3 x1.
+[[gnu::target_clones("avx2", "default")]] void substitute2(const Arrays& f, PetscScalar* x) {
+  const Lanes even{0, 0, 2, 2}, odd{1, 1, 3, 3}, rows{0, 2, 0, 2}, cols{1, 3, 1, 3}, low{0, 1, 0, 1}, high{2, 3, 2, 3};
+  for (PetscInt k = 0; k < f.nb; ++k) {
+    V4 xk, v, yv, d;
+    get(xk, x + 4 * k);
+    const V4 x0 = __builtin_shuffle(xk, even), x1 = __builtin_shuffle(xk, odd);
+    for (PetscInt p = f.ui[k]; p < f.ui[k + 1]; ++p) {
+      double* y = x + 4 * f.uj[p];
+      get(v, f.u + 4 * p);
+      get(yv, y);
+      yv += __builtin_shuffle(v, rows) * x0 + __builtin_shuffle(v, cols) * x1;
+      std::memcpy(y, &yv, sizeof yv);
+    }
+    get(d, f.d + 4 * k);
+    const V4 out = __builtin_shuffle(d, low) * x0 + __builtin_shuffle(d, high) * x1;
+    std::memcpy(x + 4 * k, &out, sizeof out);
+  }
+  for (PetscInt k = f.nb - 1; k >= 0; --k) {
+    V4 xk, v, y;
+    get(xk, x + 4 * k);
+    for (PetscInt p = f.ui[k]; p < f.ui[k + 1]; ++p) {
+      get(v, f.u + 4 * p);
+      get(y, x + 4 * f.uj[p]);
+      xk += __builtin_shuffle(v, low) * __builtin_shuffle(y, even) + __builtin_shuffle(v, high) * __builtin_shuffle(y, odd);
+    }
+    std::memcpy(x + 4 * k, &xk, sizeof xk);
+  }
+}
+
 }  // namespace
 
 void BlockLdlt2::analyse(PetscInt nb, const PetscInt* rows, const PetscInt* cols) {
@@ -183,6 +218,12 @@ void BlockLdlt2::solve(PetscScalar* x) const {
     }
     store(x + 2 * k, xk);
   }
+}
+
+void BlockLdlt2::solve2(PetscScalar* x) const {
+  const Arrays f{nb_, ai_.data(), aj_.data(), ui_.data(), uj_.data(), const_cast<double*>(d_.data()),
+                 const_cast<double*>(u_.data()), nullptr, nullptr, nullptr};  // (read only here)
+  substitute2(f, x);
 }
 
 int negative_eigenvalues_2x2(const PetscScalar* dinv, PetscInt nb) {

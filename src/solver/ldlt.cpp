@@ -137,6 +137,9 @@ void LdltFactor::set_up_blocked(Mat A) {
   HS_PETSC(VecCreateSeq(PETSC_COMM_SELF, n, xp_.out()));
   HS_PETSC(VecDuplicate(xp_, yp_.out()));
   HS_PETSC(VecDuplicate(xp_, rp_.out()));
+  HS_PETSC(VecDuplicate(xp_, xp2_.out()));
+  HS_PETSC(VecDuplicate(xp_, yp2_.out()));
+  pair_.resize(2 * std::size_t(n));
 }
 
 std::vector<PetscInt> LdltFactor::node_ordering(Mat A) {
@@ -272,17 +275,49 @@ bool LdltFactor::solve(Vec b, Vec x) {
     HS_PETSC(KSPGetConvergedReason(ksp_, &r));
     return r > 0;
   }
-  {
-    core::VecArray<const PetscScalar> bv(b);
-    core::VecArray<PetscScalar> pv(xp_);
-    for (std::size_t i = 0; i < old_of_new_.size(); ++i) pv[PetscInt(i)] = bv[old_of_new_[i]];
-  }
+  to_new(b, xp_);
   block_solve(xp_, yp_);
-  refine();
-  core::VecArray<const PetscScalar> yv(yp_);
+  refine(xp_, yp_);
+  to_old(yp_, x);
+  return true;
+}
+
+bool LdltFactor::solve_pair(Vec b1, Vec x1, Vec b2, Vec x2) {
+  if (!blocked_) return solve(b1, x1) && solve(b2, x2);
+  to_new(b1, xp_);
+  to_new(b2, xp2_);
+  {
+    core::VecArray<const PetscScalar> p1(xp_), p2(xp2_);
+    for (std::size_t k = 0; 2 * k < old_of_new_.size(); ++k) {
+      const auto i = PetscInt(2 * k);
+      pair_[4 * k] = p1[i], pair_[4 * k + 1] = p1[i + 1], pair_[4 * k + 2] = p2[i], pair_[4 * k + 3] = p2[i + 1];
+    }
+  }
+  block_.solve2(pair_.data());
+  {
+    core::VecArray<PetscScalar> y1(yp_), y2(yp2_);
+    for (std::size_t k = 0; 2 * k < old_of_new_.size(); ++k) {
+      const auto i = PetscInt(2 * k);
+      y1[i] = pair_[4 * k], y1[i + 1] = pair_[4 * k + 1], y2[i] = pair_[4 * k + 2], y2[i + 1] = pair_[4 * k + 3];
+    }
+  }
+  refine(xp_, yp_);
+  to_old(yp_, x1);
+  refine(xp2_, yp2_);
+  to_old(yp2_, x2);
+  return true;
+}
+
+void LdltFactor::to_new(Vec b, Vec bp) const {
+  core::VecArray<const PetscScalar> bv(b);
+  core::VecArray<PetscScalar> pv(bp);
+  for (std::size_t i = 0; i < old_of_new_.size(); ++i) pv[PetscInt(i)] = bv[old_of_new_[i]];
+}
+
+void LdltFactor::to_old(Vec yp, Vec x) const {
+  core::VecArray<const PetscScalar> yv(yp);
   core::VecArray<PetscScalar> xv(x);
   for (std::size_t i = 0; i < old_of_new_.size(); ++i) xv[old_of_new_[i]] = yv[PetscInt(i)];
-  return true;
 }
 
 void LdltFactor::block_solve(Vec x, Vec y) const {
@@ -299,15 +334,15 @@ PetscErrorCode LdltFactor::apply_factor(PC pc, Vec x, Vec y) {
   PetscFunctionReturn(0);
 }
 
-void LdltFactor::refine() {
+void LdltFactor::refine(Vec b, Vec y) {
   // Without pivoting, an LDL^T of an indefinite matrix can lose digits to small pivots (seen in
   // this ordering on shifted tangents: relative residuals up to 0.25 where the scalar qmd factor
   // kept 1e-12). Where the residual shows it, GMRES preconditioned by the factor, from the
   // factor's solution, restores them; where the factor is accurate this costs one product.
   PetscReal bn, rn;
-  HS_PETSC(VecNorm(xp_, NORM_2, &bn));
-  HS_PETSC(MatMult(F_, yp_, rp_));
-  HS_PETSC(VecAYPX(rp_, -1.0, xp_));
+  HS_PETSC(VecNorm(b, NORM_2, &bn));
+  HS_PETSC(MatMult(F_, y, rp_));
+  HS_PETSC(VecAYPX(rp_, -1.0, b));
   HS_PETSC(VecNorm(rp_, NORM_2, &rn));
   constexpr double rtol = 1e-10;
   if (!(rn > rtol * bn)) return;
@@ -317,7 +352,7 @@ void LdltFactor::refine() {
   }
   HS_PETSC(KSPSetOperators(refine_, F_, F_));
   HS_PETSC(KSPSetTolerances(refine_, 1e-30, rtol * bn, PETSC_DEFAULT, 30));
-  HS_PETSC(KSPSolve(refine_, xp_, yp_));  // not converged in 30: the best it found (Newton judges)
+  HS_PETSC(KSPSolve(refine_, b, y));  // not converged in 30: the best it found (Newton judges)
 }
 
 int LdltFactor::negative_eigenvalues() const {

@@ -268,10 +268,22 @@ bool NonlinearSolver::tangent_response(bool guess) {
   negative_pivots_ = -1;
   if (!tangent_->assemble(u_, s_)) return false;
   if (!tangent_->solve(problem_.load_at(u_), a_, guess)) return false;
+  inertia_of_response();
+  return true;
+}
+
+bool NonlinearSolver::tangent_responses(Vec r, Vec b) {
+  negative_pivots_ = -1;
+  if (!tangent_->assemble(u_, s_)) return false;
+  if (!tangent_->solve_pair(problem_.load_at(u_), a_, true, r, b)) return false;
+  inertia_of_response();
+  return true;
+}
+
+void NonlinearSolver::inertia_of_response() {
   // The inertia of K(u_) is known only from a factor of K(u_) itself. (LU: the symmetric part's,
   // one more factorisation, is taken at the final state only: correct().)
   if (tangent_->factor_is_current() && !tangent_->lu()) negative_pivots_ = tangent_->negative_eigenvalues();
-  return true;
 }
 
 bool NonlinearSolver::factorise_here() {

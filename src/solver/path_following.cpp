@@ -200,7 +200,7 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
     ++its;
     // Bordered system: K du - dalpha f = -R, c . du = d - m, with K^-1 f = a and K^-1 R = b
     // (a from the previous iterate's as the initial guess: the tangent moved little).
-    if (!tangent_response(true) || !tangent_->solve(r_, b_, false)) {
+    if (!tangent_responses(r_, b_)) {
       why = "tangent factorisation or solve failed";
       return false;
     }

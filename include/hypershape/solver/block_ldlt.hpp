@@ -30,6 +30,9 @@ class BlockLdlt2 {
   bool factorise(const PetscScalar* values);
   /// x = A^-1 x for the matrix last factorised (x: 2 nb entries).
   void solve(PetscScalar* x) const;
+  /// Two right-hand sides at once, interleaved by node: x = (a_k0, a_k1, b_k0, b_k1) for node k
+  /// (4 nb entries). Each one's numbers are solve()'s; U is read once for both.
+  void solve2(PetscScalar* x) const;
   /// Negative eigenvalues of the matrix last factorised (Sylvester: those of D).
   int negative_eigenvalues() const;
   PetscInt blocks() const { return nb_; }

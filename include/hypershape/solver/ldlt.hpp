@@ -63,6 +63,9 @@ class LdltFactor {
   bool factorise(Mat A);
   /// x = A^-1 b for the A last factorised. False if the solve failed. Collective.
   bool solve(Vec b, Vec x);
+  /// x1 = A^-1 b1 and x2 = A^-1 b2, the same numbers as two solve() calls (the blocked kind reads
+  /// its factor once for both). False if a solve failed. Collective.
+  bool solve_pair(Vec b1, Vec x1, Vec b2, Vec x2);
   /// x ~ A^-1 b inside a preconditioner: the single kind's unrefined solve, the others' solve.
   bool precondition(Vec b, Vec x) { return single_ ? single_->solve_unrefined(b, x) : solve(b, x); }
   /// Negative eigenvalues of the A last factorised; -1 unknown. Collective.
@@ -80,8 +83,12 @@ class LdltFactor {
   /// F_ with the upper 2x2-block pattern of A in the new ordering, and source_ / target_.
   void build_block_pattern(Mat A, const std::vector<PetscInt>& new_block);
   void scatter_values(Mat A);
-  /// Blocked kind: GMRES on F_ preconditioned by the factor where the solve lost digits.
-  void refine();
+  /// Blocked kind: GMRES on F_ preconditioned by the factor where the solve y of F_ y = b (both
+  /// in the new ordering) lost digits.
+  void refine(Vec b, Vec y);
+  /// Blocked kind: b (old ordering) into bp (new), and yp (new) into x (old).
+  void to_new(Vec b, Vec bp) const;
+  void to_old(Vec yp, Vec x) const;
   /// Blocked kind: y = F_^-1 x with block_.
   void block_solve(Vec x, Vec y) const;
   static PetscErrorCode apply_factor(PC pc, Vec x, Vec y);
@@ -99,6 +106,8 @@ class LdltFactor {
   /// target_[k] of F_'s (the upper triangle's only; in F_'s order, so the writes stream).
   std::vector<std::uint32_t> source_, target_;
   core::VecH xp_, yp_, rp_;  ///< b, x and the residual in the new ordering
+  core::VecH xp2_, yp2_;     ///< solve_pair's second b and x in the new ordering
+  std::vector<PetscScalar> pair_;  ///< solve_pair's right-hand sides, interleaved by node
   core::KSPH refine_;
   std::unique_ptr<SingleFactor> single_;  ///< the single kind (then F_ and ksp_ are unused)
 };

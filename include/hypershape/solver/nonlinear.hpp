@@ -286,6 +286,10 @@ class NonlinearSolver {
   /// Assembles K(u_) and solves K a_ = f_ext (Tangent::solve: a kept factor, or a fresh one).
   /// `guess`: a_ holds the response at a nearby state. False if the tangent cannot be formed.
   bool tangent_response(bool guess);
+  /// tangent_response(true) and K b = r with the same factor: the corrector's two solves.
+  bool tangent_responses(Vec r, Vec b);
+  /// negative_pivots_ from the factor just used, where it is of the assembled tangent.
+  void inertia_of_response();
   /// tangent_response() at rest (u = 0): K(0) is the same for every load case of the problem
   /// (dead loads), so in 2D its factor is made once and kept (Tangent::use_rest_factor).
   bool rest_response();

@@ -105,6 +105,9 @@ class Tangent {
   /// preconditioned by the factor in use, refreshed by the budget rule; otherwise a fresh
   /// factorisation and a direct solve. False if no solve succeeded. Collective.
   bool solve(Vec b, Vec x, bool guess);
+  /// solve(b1, x1, guess1) then solve(b2, x2, false), the same numbers; a direct solver's
+  /// factor is read once for both. x1, x2 must not alias b2, b1. Collective.
+  bool solve_pair(Vec b1, Vec x1, bool guess1, Vec b2, Vec x2);
   /// Applies the inverse of the factor in use: y = F^-1 x (no Krylov). Collective.
   bool apply_factor(Vec x, Vec y, bool refined = true);
   /// Inertia of the factor in use; -1 unknown. Exact for K(u) only if factor_is_current().
