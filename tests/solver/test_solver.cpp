@@ -310,6 +310,20 @@ TEST_CASE("The solver's factorisation and Krylov counters are exact", "[solver]"
   }
 }
 
+TEST_CASE("The blocked LDL^T's factorisations are counted as they happen", "[solver]") {
+  // The default 2D path factorises with BlockLdlt2 (log event HSFactorBlocked), not PETSc's
+  // Cholesky: the counter must be that event's count, and PETSc's must not move.
+  HS_PETSC(PetscLogDefaultBegin());
+  physics::Problem p{PETSC_COMM_WORLD, hstest::disk_mesh(0.2), hstest::disk_effects(), hstest::degree(2)};
+  solver::NonlinearSolver ns(p, solver::SolverOptions{});
+  const double own0 = event_count("HSFactorBlocked"), petsc0 = event_count("MatCholFctrNum");
+  const solver::TargetResult t = ns.solve_for_target(0.3);
+  REQUIRE(t.converged);
+  CHECK(t.linear.numeric_factorizations > t.newton_iterations / 2);
+  CHECK(double(t.linear.numeric_factorizations) == event_count("HSFactorBlocked") - own0);
+  CHECK(event_count("MatCholFctrNum") == petsc0);
+}
+
 TEST_CASE("Failed increments are recovered and their cost counted; a spent budget is a recorded failure", "[solver]") {
   DiskScene scene;
   auto& p = scene.problem;
