@@ -18,11 +18,9 @@ namespace {
 core::KSPH petsc_factor(Mat S) {
   core::KSPH ksp;
   HS_PETSC(KSPCreate(PETSC_COMM_SELF, ksp.out()));
-  HS_PETSC(KSPSetType(ksp, KSPPREONLY));
+  solver::configure_direct_solver(ksp, PETSC_COMM_SELF, 2);  // PETSc's own LDL^T (2D, one rank)
   PC pc;
   HS_PETSC(KSPGetPC(ksp, &pc));
-  HS_PETSC(PCSetType(pc, PCCHOLESKY));
-  HS_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERPETSC));
   HS_PETSC(PCFactorSetMatOrderingType(pc, MATORDERINGNATURAL));
   HS_PETSC(KSPSetOperators(ksp, S, S));
   HS_PETSC(PCSetUp(pc));
