@@ -111,14 +111,9 @@ LdltFactor::LdltFactor(const physics::Problem& problem, const std::string& prefi
     single_ = std::make_unique<SingleFactor>();
     return;
   }
+  // The blocked kind factorises with block_ (ksp_ is the general kind's).
   blocked_ = own_kind && problem.space().dim() == 2;
-  if (blocked_) {
-    PC pc;
-    HS_PETSC(KSPGetPC(ksp_, &pc));
-    HS_PETSC(PCFactorSetMatOrderingType(pc, MATORDERINGNATURAL));  // the nodes are permuted already
-  } else {
-    HS_PETSC(KSPSetFromOptions(ksp_));
-  }
+  if (!blocked_) HS_PETSC(KSPSetFromOptions(ksp_));
 }
 
 void LdltFactor::set_up_blocked(Mat A) {
@@ -330,7 +325,11 @@ PetscErrorCode LdltFactor::apply_factor(PC pc, Vec x, Vec y) {
   void* ctx;
   PetscFunctionBeginUser;
   PetscCall(PCShellGetContext(pc, &ctx));
-  static_cast<LdltFactor*>(ctx)->block_solve(x, y);
+  try {  // (no exception through PETSc's frames)
+    static_cast<LdltFactor*>(ctx)->block_solve(x, y);
+  } catch (const std::exception& e) {
+    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_LIB, "blocked LDL^T solve: %s", e.what());
+  }
   PetscFunctionReturn(0);
 }
 

@@ -73,8 +73,6 @@ class LdltFactor {
   bool factored() const { return factored_; }
   bool blocked() const { return blocked_; }
   bool single() const { return single_ != nullptr; }
-  /// The factor's KSP (preonly Cholesky) and the matrix it factors.
-  KSP ksp() const { return ksp_.get(); }
 
  private:
   void set_up_blocked(Mat A);
