@@ -3,7 +3,11 @@
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <string>
+
+#include "hypershape/physics/hyperelastic.hpp"
 
 #include "support/helpers.hpp"
 
@@ -271,4 +275,31 @@ TEST_CASE("Energy, residual and tangent report det F <= 0 instead of returning g
   CHECK_FALSE(p->residual(u, 0.0, r));
   core::MatH J = p->create_matrix();
   CHECK_FALSE(p->jacobian(u, J));
+}
+
+TEST_CASE("The 2D tangent's point contribution is Eigen's product, bit for bit", "[assembly]") {
+  // add_point_tangent (2D: along AG's rows, vectorised) must give the numbers of the Eigen
+  // expression it replaced, Ke(a i, :) += w G(a, :) AG(i:, :): the factory's data rest on it.
+  constexpr int NB = 6, D = 2, ND = NB * D;
+  Eigen::Matrix<double, NB, D> G;
+  Eigen::Matrix<double, D * D, ND, Eigen::RowMajor> AG;
+  std::uint64_t state = 12345;
+  auto next = [&] {  // deterministic values with full mantissas
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return double(state >> 11) / double(1ULL << 53) * 2.0 - 1.0;
+  };
+  for (int a = 0; a < NB; ++a)
+    for (int j = 0; j < D; ++j) G(a, j) = next();
+  for (int r = 0; r < D * D; ++r)
+    for (int c = 0; c < ND; ++c) AG(r, c) = next();
+  const Eigen::Matrix<double, D * D, ND> AGc = AG;  // the former, column-major layout
+  Eigen::Matrix<double, ND, ND, Eigen::RowMajor> mine, eigen;
+  for (int r = 0; r < ND; ++r)
+    for (int c = 0; c < ND; ++c) mine(r, c) = eigen(r, c) = next();
+  for (const double w : {0.37, 1.0, 2.5e-3}) {
+    physics::detail::add_point_tangent<D, NB>(G, AG, w, mine);
+    for (int a = 0; a < NB; ++a)
+      for (int i = 0; i < D; ++i) eigen.row(a * D + i).noalias() += w * (G.row(a) * AGc.middleRows<D>(i * D));
+  }
+  CHECK(std::memcmp(mine.data(), eigen.data(), sizeof(double) * ND * ND) == 0);
 }
