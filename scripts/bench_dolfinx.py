@@ -50,6 +50,12 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 
+
+def in_repo(path):
+    """The path relative to the repository where it lies inside it (the JSON names no machine)."""
+    p = path.resolve()
+    return str(p.relative_to(ROOT)) if p.is_relative_to(ROOT) else str(path)
+
 for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS"):
     os.environ.setdefault(var, "1")
 
@@ -509,7 +515,7 @@ def main():
     rtol = float(solver_block.get("rtol", 1e-9))
     target_rtol = float(solver_block.get("target_rtol", 1e-3))
     n_targets, passes = len(targets), args.repeat + 1
-    report = {"scene": str(args.scene), "hypershape": str(exe), "hypershape_args": hs_extra,
+    report = {"scene": in_repo(Path(args.scene)), "hypershape": in_repo(exe), "hypershape_args": hs_extra,
               "hypershape_timing": "per load case inside one process (solve --targets --repeat)" if multi
               else "one process per load case, its 'solve' phase (cold)",
               "targets": targets, "repeat": args.repeat,
