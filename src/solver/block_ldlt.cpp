@@ -122,7 +122,14 @@ struct Arrays {
 /// BlockLdlt2::solve2's substitutions, compiled as eliminate() is. Lanes (a0, a1, b0, b1) of a
 /// node; each lane sums as solve() does: y0 += v0 x0 + v1 x1, y1 += v2 x0 + v3 x1 forward,
 /// x0 += v0 y0 + v2 y1, x1 += v1 y0 + v3 y1 backward, D^-1 as d0 x0 + d2 x1, d1 x0 + d3 x1.
-[[gnu::target_clones("avx2", "default")]] void substitute2(const Arrays& f, PetscScalar* x) {
+/// The factor as the substitutions read it (no work arrays, nothing written).
+struct Factor {
+  PetscInt nb;
+  const PetscInt *ui, *uj;
+  const double *d, *u;
+};
+
+[[gnu::target_clones("avx2", "default")]] void substitute2(const Factor& f, PetscScalar* x) {
   const Lanes even{0, 0, 2, 2}, odd{1, 1, 3, 3}, rows{0, 2, 0, 2}, cols{1, 3, 1, 3}, low{0, 1, 0, 1}, high{2, 3, 2, 3};
   for (PetscInt k = 0; k < f.nb; ++k) {
     V4 xk, v, yv, d;
@@ -221,9 +228,7 @@ void BlockLdlt2::solve(PetscScalar* x) const {
 }
 
 void BlockLdlt2::solve2(PetscScalar* x) const {
-  const Arrays f{nb_, ai_.data(), aj_.data(), ui_.data(), uj_.data(), const_cast<double*>(d_.data()),
-                 const_cast<double*>(u_.data()), nullptr, nullptr, nullptr};  // (read only here)
-  substitute2(f, x);
+  substitute2(Factor{nb_, ui_.data(), uj_.data(), d_.data(), u_.data()}, x);
 }
 
 int negative_eigenvalues_2x2(const PetscScalar* dinv, PetscInt nb) {
