@@ -18,6 +18,7 @@ PACKAGES=(
   catch2                            # unit-test framework (v2.13)
   openmpi-bin                       # mpiexec
   libmumps-dev                      # MUMPS in single precision (solver.factor_precision: single; PETSc's pulls it in)
+  libsuitesparse-dev                # SuiteSparse's AMD: the blocked LDL^T's fill-reducing node ordering (PETSc's pulls it in)
   libopenblas0-serial               # optimised BLAS for MUMPS (4-6x faster factorisations)
   libyaml-cpp-dev                   # scene and dataset files
   libcli11-dev                      # command-line parsing

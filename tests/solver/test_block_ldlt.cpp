@@ -174,3 +174,38 @@ TEST_CASE("The blocked LDL^T's paired solve gives each solve's numbers", "[solve
   CHECK(std::memcmp(vb1.data(), vb2.data(), vb1.size() * sizeof(double)) == 0);
   CHECK(std::abs(vb1[0]) + std::abs(vb1.back()) > 0);  // not two zero vectors
 }
+
+TEST_CASE("The blocked factor's node ordering is PETSc's AMD ordering of the matrix as BAIJ", "[solver]") {
+  // amd_node_ordering calls SuiteSparse's AMD on the block graph itself; the factors' data rest on
+  // it being the permutation MatGetOrdering gave for the BAIJ conversion it replaced.
+  int ranks;
+  MPI_Comm_size(PETSC_COMM_WORLD, &ranks);
+  if (ranks != 1) return;  // (the blocked factor is serial)
+  for (const int degree : {1, 2})
+    for (const double h : {0.2, 0.07}) {
+      INFO("P" << degree << ", h " << h);
+      physics::Problem p{PETSC_COMM_WORLD, hstest::disk_mesh(h), hstest::disk_effects(), hstest::degree(degree)};
+      core::MatH K = p.create_matrix(), B;
+      core::VecH u = p.create_vector();
+      HS_PETSC(VecCopy(p.load(), u));
+      HS_PETSC(VecScale(u, 0.02));
+      REQUIRE(p.jacobian(u, K));
+      HS_PETSC(MatConvert(K, MATSEQBAIJ, MAT_INITIAL_MATRIX, B.out()));
+      core::ISH rp, cp;
+      HS_PETSC(MatGetOrdering(B, MATORDERINGAMD, rp.out(), cp.out()));
+      PetscInt nb;
+      HS_PETSC(ISGetSize(rp, &nb));
+      const PetscInt* r;
+      HS_PETSC(ISGetIndices(rp, &r));
+      const std::vector<PetscInt> theirs(r, r + nb);
+      HS_PETSC(ISRestoreIndices(rp, &r));
+      const std::vector<PetscInt> ours = solver::amd_node_ordering(K);
+      PetscInt n;
+      HS_PETSC(MatGetSize(K, &n, nullptr));
+      REQUIRE(nb == n / 2);
+      CHECK(ours == theirs);
+      std::vector<PetscInt> identity(std::size_t(nb), 0);
+      for (PetscInt i = 0; i < nb; ++i) identity[std::size_t(i)] = i;
+      CHECK(ours != identity);  // a real reordering
+    }
+}

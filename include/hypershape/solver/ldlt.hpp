@@ -39,6 +39,11 @@ namespace hypershape::solver {
 /// factorisation (MatGetInertia; 2x2 blocks: from D). -1 where the KSP holds no such factorisation.
 int negative_eigenvalues(KSP ksp);
 
+/// The blocked factor's fill-reducing node ordering of a matrix of 2x2 blocks (block size 2, one
+/// rank): SuiteSparse's AMD on the block graph, the permutation PETSc's MatGetOrdering(AMD) gives
+/// for the matrix converted to BAIJ, without the conversion. perm[new] = old node.
+std::vector<PetscInt> amd_node_ordering(Mat A);
+
 /// Sets a KSP to LDL^T (`symmetric`) or LU: PETSc's own (LDL^T: qmd ordering, LU: nested
 /// dissection) in 2D on one rank, MUMPS otherwise (options with the KSP's prefix still apply when
 /// the caller calls KSPSetFromOptions).
