@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstring>
 #include <string>
+#include <utility>
 
 #include "hypershape/physics/hyperelastic.hpp"
 
@@ -71,6 +72,16 @@ void check_equals_pointwise(const physics::Problem& p, Vec u, Mat J) {
   INFO("tangent: ||J||_F = " << jn << ", relative difference " << dn / jn);
   REQUIRE(jn > 0);
   CHECK(dn / jn < 1e-12);
+}
+
+/// Two deformed states of p: the smooth field at half and at full amplitude.
+std::pair<core::VecH, core::VecH> two_states(const physics::Problem& p, int dim) {
+  std::pair<core::VecH, core::VecH> out{p.create_vector(), p.create_vector()};
+  hstest::interpolate(
+      p, [dim](const double* x, double* v) { smooth_field(x, v, dim, 0.5); }, out.first);
+  hstest::interpolate(
+      p, [dim](const double* x, double* v) { smooth_field(x, v, dim, 1.0); }, out.second);
+  return out;
 }
 
 }  // namespace
@@ -151,12 +162,7 @@ TEST_CASE("Re-assembly straight into the CSR values equals PETSc's assembly", "[
   for (const Case& c : cases) {
     DYNAMIC_SECTION(c.name) {
       auto p = make_problem(c.dim, c.degree);
-      const int dim = c.dim;
-      core::VecH u0 = p->create_vector(), u = p->create_vector();
-      hstest::interpolate(
-          *p, [dim](const double* x, double* v) { smooth_field(x, v, dim, 0.5); }, u0);
-      hstest::interpolate(
-          *p, [dim](const double* x, double* v) { smooth_field(x, v, dim, 1.0); }, u);
+      auto [u0, u] = two_states(*p, c.dim);
       core::MatH J = p->create_matrix();
       REQUIRE(p->jacobian(u0, J));  // fixes the pattern
       {
@@ -180,12 +186,7 @@ TEST_CASE("Re-assembly straight into the CSR values is MatSetValues' sum to the 
   for (const Case& c : cases) {
     DYNAMIC_SECTION(c.name) {
       auto p = make_problem(c.dim, c.degree);
-      const int dim = c.dim;
-      core::VecH u0 = p->create_vector(), u = p->create_vector();
-      hstest::interpolate(
-          *p, [dim](const double* x, double* v) { smooth_field(x, v, dim, 0.5); }, u0);
-      hstest::interpolate(
-          *p, [dim](const double* x, double* v) { smooth_field(x, v, dim, 1.0); }, u);
+      auto [u0, u] = two_states(*p, c.dim);
       core::MatH J1 = p->create_matrix(), J2 = p->create_matrix(), ref;
       HS_PETSC(MatConvert(J1, MATSEQBAIJ, MAT_INITIAL_MATRIX, ref.out()));
       REQUIRE(p->jacobian(u, ref));  // MatSetValues
