@@ -476,7 +476,10 @@ const std::vector<PetscInt>& Space::csr_offsets(Mat J) const {
   }
   const bool known = build_csr_offsets(ia, ja, n);
   HS_PETSC(MatRestoreRowIJ(J, 0, PETSC_FALSE, PETSC_FALSE, &n, &ia, &ja, &done));
-  if (known) csr_matrices_.push_back(key);
+  if (known) {
+    if (csr_matrices_.size() >= 16) csr_matrices_.erase(csr_matrices_.begin());  // (a short list: a few live matrices)
+    csr_matrices_.push_back(key);
+  }
   return csr_offsets_;
 }
 
