@@ -28,6 +28,9 @@ void parse_solver_block(const YamlBlock& sol, solver::SolverOptions& s) {
   if (sol.has("newton_budget")) s.newton_budget = int(sol.integer("newton_budget"));
   if (s.newton_budget < 1) sol.fail("newton_budget", "must be >= 1");
   if (sol.has("fallback")) s.fallback = sol.boolean("fallback");
+  if (sol.has("step_growth")) s.step_growth = sol.number("step_growth");
+  if (!(s.step_growth >= 1 && s.step_growth <= 4))
+    sol.fail("step_growth", "must be in [1, 4] (the next increment's length after an easy one, as a multiple)");
   if (sol.has("abandon_off_path")) s.abandon_off_path = sol.boolean("abandon_off_path");
   if (sol.has("arc_length_rescue")) s.arc_length_rescue = sol.boolean("arc_length_rescue");
   if (sol.has("branch_switches")) s.branch_switches = int(sol.integer("branch_switches"));
@@ -47,7 +50,7 @@ void parse_solver_block(const YamlBlock& sol, solver::SolverOptions& s) {
   if (s.tangent.reuse && (s.tangent.linear == solver::LinearSolver::gamg || s.tangent.linear == solver::LinearSolver::hypre))
     sol.fail("factor_reuse", "must be false with linear: gamg or hypre (a kept factor is the direct solver's)");
   sol.allowed("rtol, max_newton, factor_reuse, krylov_budget, krylov_rtol, max_increments, target_rtol, control, path_rtol, newton_budget, fallback, "
-              "branch_switches, abandon_off_path, arc_length_rescue, linear, linear_auto_dofs, factor_precision");
+              "branch_switches, step_growth, abandon_off_path, arc_length_rescue, linear, linear_auto_dofs, factor_precision");
   sol.check_all_used();
 }
 

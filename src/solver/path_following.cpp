@@ -491,7 +491,7 @@ TargetResult NonlinearSolver::path(double target, double start, int spent, PathS
       first_accepted = false;
       d = d_next;
       if (last) break;
-      step = next_step(step, its - its_before);
+      step = next_step(step, its - its_before, opt_.step_growth);
       continue;
     }
     ++t.failed_increments;
@@ -604,7 +604,7 @@ TargetResult NonlinearSolver::arc_path(double target, double start) {
     HS_PETSC(VecWAXPY(arc_dir_, -1.0, backup_, u_));
     PetscReal len;
     HS_PETSC(VecNormalize(arc_dir_, &len));
-    step = next_step(step, its - its_before);
+    step = next_step(step, its - its_before, opt_.step_growth);
   }
   arc_ = false;
   if (!crossed) {

@@ -48,6 +48,7 @@ expect spring_negative   's/^load:/  spring: {normal_stiffness: -2}\nload:/' 'ef
 expect spring_both_forms 's/^load:/  spring: {stiffness: 1, tangential_stiffness: 1}\nload:/' 'effects.spring.stiffness'
 expect inclusions_no_ratio 's/nu: 0.49}/nu: 0.49, inclusions: 2, inclusion_radius: 0.2}/' 'effects.neo_hookean.inclusion_ratio'
 expect inclusions_fraction 's/nu: 0.49}/nu: 0.49, inclusions: 1.5, inclusion_radius: 0.2, inclusion_ratio: 3}/' 'effects.neo_hookean.inclusions'
+expect step_growth_below_1 's/^load: {target: 0.3}/load: {target: 0.3}\nsolver: {step_growth: 0.5}/' 'solver.step_growth'
 expect not_yaml          's/^geometry: {base: circle}/geometry: {base: [circle/' 'YAML'
 
 # An unwritable output directory: rejected before any work.
@@ -57,6 +58,6 @@ if "$bin" solve "$work/ok.yaml" -o "$work/no/such/dir/out.h5" 2>/dev/null; then
 
 # PETSc's -help opens with the project's own settings (YAML keys, the solver's with defaults).
 help=$("$bin" solve -help 2>&1 | head -6)
-grep -q "solver:  rtol 1e-09, max_newton 12" <<<"$help" && grep -q "path_rtol 0.3" <<<"$help" &&
+grep -q "solver:  rtol 1e-09, max_newton 12" <<<"$help" && grep -q "path_rtol 0.3" <<<"$help" && grep -q "step_growth 1.5" <<<"$help" &&
   ok "-help lists the solver's keys with their defaults" || fail "-help: $help"
 finish

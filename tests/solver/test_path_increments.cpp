@@ -72,11 +72,14 @@ bool creeps(double rn0, std::initializer_list<std::pair<double, double>> steps) 
 
 }  // namespace
 
-TEST_CASE("Step control: doubling, halving, and a creeping corrector given up", "[solver]") {
-  CHECK(solver::next_step(0.1, 1) == 0.2);
-  CHECK(solver::next_step(0.1, 2) == 0.2);
-  CHECK(solver::next_step(0.1, 4) == 0.1);
-  CHECK(solver::next_step(0.1, 6) == 0.05);
+TEST_CASE("Step control: growing, halving, and a creeping corrector given up", "[solver]") {
+  const double growth = solver::SolverOptions{}.step_growth;
+  CHECK(growth == 1.5);
+  CHECK(solver::next_step(0.1, 1, growth) == 0.1 * growth);
+  CHECK(solver::next_step(0.1, 2, growth) == 0.1 * growth);
+  CHECK(solver::next_step(0.1, 2, 2.0) == 0.2);
+  CHECK(solver::next_step(0.1, 4, growth) == 0.1);
+  CHECK(solver::next_step(0.1, 6, growth) == 0.05);
   // Three steps cut below 0.3 that leave |R| above half of what it was: creeping.
   CHECK_FALSE(creeps(10, {{0.1, 9}, {0.05, 8}}));  // only two steps yet
   CHECK(creeps(10, {{0.1, 9}, {0.05, 8}, {0.2, 7}}));

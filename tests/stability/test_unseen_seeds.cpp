@@ -141,7 +141,9 @@ TEST_CASE("A target on the unstable segment of a fold is reported as a fold", "[
     c.set(load_id);
     const auto r = ns.solve_for_target(target);
     INFO("alone, no switch: " << r.reason);
-    REQUIRE(r.reason.rfind("fold:", 0) == 0);
+    // Found by the path itself, or by the arc-length rescue after it (31337/4/30 with the step
+    // growth of 1.5 spends its Newton budget near the limit point first).
+    REQUIRE(r.reason.find("fold: max|u| = target lies on an unstable segment of the path") != std::string::npos);
     const physics::Problem& p = *c.sp.problem;
     CHECK(std::abs(p.max_displacement(ns.solution()) / target - 1) <= opt.target_rtol);
     core::VecH res = p.create_vector();
@@ -214,7 +216,10 @@ TEST_CASE("An increment whose iterate leaves the path is abandoned, and the path
   // iterate (they creep for 4-12 iterations otherwise). The load case must still end stable on
   // target, in the equilibrium a load-controlled solve from rest to the same alpha reaches; by
   // default (off) no increment is abandoned so.
+  // The increments were found with the former step growth of 2 (with 1.5, load 8's predictors
+  // no longer overshoot so): the test keeps it, to exercise the mechanism.
   Case c(2024, 0);
+  c.cfg.solver.step_growth = 2.0;
   solver::SolverOptions opt = c.cfg.solver;
   opt.abandon_off_path = true;
   for (const int load_id : {5, 8}) {
@@ -251,16 +256,23 @@ TEST_CASE("The arc-length rescue ends stable on target where the path and its br
   // converge; 31337/12/20 passes a bifurcation from rest, and the branch a switch finds has a
   // fold at the target. The rescue runs only after that (its reason says so: the case exercises
   // it), follows the path from rest by arc-length continuation, and ends at a verified stable
-  // equilibrium with max|u| = target.
+  // equilibrium with max|u| = target. Both were found with the former step growth of 2, kept
+  // here to exercise the rescue; with the default growth of 1.5 both end stable on target
+  // without it (777/11/20 after a branch switch, 31337/12/20 on the path itself), checked too.
   const std::vector<std::tuple<int, int, int>> cases = {{777, 11, 20}, {31337, 12, 20}};
   for (const auto& [seed, shape_id, load_id] : cases) {
     Case c(std::uint64_t(seed), shape_id);
-    solver::SolverOptions opt = c.cfg.solver;
-    opt.arc_length_rescue = true;
-    solver::NonlinearSolver ns(*c.sp.problem, opt);
-    const auto r = replay(c, ns, 0, load_id);
-    INFO("seed " << seed << " shape " << shape_id << " load " << load_id << ": " << r.reason);
-    CHECK(r.reason.find("arc-length continuation") != std::string::npos);
-    hstest::check_stable_on_target(*c.sp.problem, ns.solution(), r, c.loads[std::size_t(load_id)].target, opt);
+    const double target = c.loads[std::size_t(load_id)].target;
+    for (const double growth : {2.0, c.cfg.solver.step_growth}) {
+      solver::SolverOptions opt = c.cfg.solver;
+      opt.arc_length_rescue = true;
+      opt.step_growth = growth;
+      solver::NonlinearSolver ns(*c.sp.problem, opt);
+      const auto r = replay(c, ns, 0, load_id);
+      INFO("seed " << seed << " shape " << shape_id << " load " << load_id << ", step growth " << growth << ": "
+                   << r.reason);
+      CHECK((r.reason.find("arc-length continuation") != std::string::npos) == (growth == 2.0));
+      hstest::check_stable_on_target(*c.sp.problem, ns.solution(), r, target, opt);
+    }
   }
 }
