@@ -29,8 +29,9 @@ void parse_solver_block(const YamlBlock& sol, solver::SolverOptions& s) {
   if (s.newton_budget < 1) sol.fail("newton_budget", "must be >= 1");
   if (sol.has("fallback")) s.fallback = sol.boolean("fallback");
   if (sol.has("step_growth")) s.step_growth = sol.number("step_growth");
-  if (!(s.step_growth >= 1 && s.step_growth <= 4))
-    sol.fail("step_growth", "must be in [1, 4] (the next increment's length after an easy one, as a multiple)");
+  if (!(s.step_growth == 0 || (s.step_growth >= 1 && s.step_growth <= 4)))
+    sol.fail("step_growth", "must be 0 (by dimension: 1.5 in 2D, 2 in 3D) or in [1, 4] (the next increment's length "
+                            "after an easy one, as a multiple of the last)");
   if (sol.has("abandon_off_path")) s.abandon_off_path = sol.boolean("abandon_off_path");
   if (sol.has("arc_length_rescue")) s.arc_length_rescue = sol.boolean("arc_length_rescue");
   if (sol.has("branch_switches")) s.branch_switches = int(sol.integer("branch_switches"));

@@ -491,7 +491,7 @@ TargetResult NonlinearSolver::path(double target, double start, int spent, PathS
       first_accepted = false;
       d = d_next;
       if (last) break;
-      step = next_step(step, its - its_before, opt_.step_growth);
+      step = next_step(step, its - its_before, step_growth(opt_.step_growth, problem_.space().dim()));
       continue;
     }
     ++t.failed_increments;
@@ -604,7 +604,7 @@ TargetResult NonlinearSolver::arc_path(double target, double start) {
     HS_PETSC(VecWAXPY(arc_dir_, -1.0, backup_, u_));
     PetscReal len;
     HS_PETSC(VecNormalize(arc_dir_, &len));
-    step = next_step(step, its - its_before, opt_.step_growth);
+    step = next_step(step, its - its_before, step_growth(opt_.step_growth, problem_.space().dim()));
   }
   arc_ = false;
   if (!crossed) {

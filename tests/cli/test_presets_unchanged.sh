@@ -15,9 +15,6 @@
 # out, and preset_r3s is the preset, fingerprinted when it moved. On 2026-11-27 the corrector
 # began to give up a creeping increment (CreepWatch, issue 23): r2's shape 0, load 0 takes one
 # Newton iteration fewer (newton_iterations and recovery_iterations updated; u unchanged).
-# Later on 2026-11-27 the path's increments grew by 1.5 instead of 2 after an easy one (issue 23):
-# r3m's shape 0, load 1 takes 9 Newton iterations instead of 21, without its failed increment
-# (solves, failed_increments, newton_iterations, recovery_iterations updated; u unchanged to 1e-9).
 # Needs HYPERSHAPE_BIN and HYPERSHAPE_SOURCE_DIR (set by CTest).
 . "$(dirname "$0")/lib.sh"
 for name in r2 e2 r3 r3m r3s; do

@@ -46,7 +46,7 @@ shapes:
   count: 4
 seed: 3
 name: same
-solver: {rtol: 1.0e-9, linear: auto, step_growth: 1.5, abandon_off_path: false, arc_length_rescue: true}
+solver: {rtol: 1.0e-9, linear: auto, step_growth: 0, abandon_off_path: false, arc_length_rescue: true}
 petsc: {}
 preset: random2d
 )") == a);

@@ -73,8 +73,12 @@ bool creeps(double rn0, std::initializer_list<std::pair<double, double>> steps) 
 }  // namespace
 
 TEST_CASE("Step control: growing, halving, and a creeping corrector given up", "[solver]") {
-  const double growth = solver::SolverOptions{}.step_growth;
-  CHECK(growth == 1.5);
+  // By dimension unless set: 1.5 in 2D, 2 in 3D.
+  CHECK(solver::SolverOptions{}.step_growth == 0);
+  CHECK(solver::step_growth(0, 2) == 1.5);
+  CHECK(solver::step_growth(0, 3) == 2.0);
+  CHECK(solver::step_growth(1.25, 3) == 1.25);
+  const double growth = solver::step_growth(0, 2);
   CHECK(solver::next_step(0.1, 1, growth) == 0.1 * growth);
   CHECK(solver::next_step(0.1, 2, growth) == 0.1 * growth);
   CHECK(solver::next_step(0.1, 2, 2.0) == 0.2);

@@ -88,8 +88,9 @@ struct SolverOptions {
   int max_halvings = 6;        ///< displacement control: failed increments in a row (then: fail)
   int max_newton = 12;         ///< Newton iterations per increment (then: smaller increment)
   /// Displacement control: an increment whose corrector took <= 2 iterations is followed by one
-  /// this many times longer (next_step). 1.5 since 2026-11-27 (2 before; issue 23).
-  double step_growth = 1.5;
+  /// this many times longer (next_step). 0: by dimension (step_growth(): 1.5 in 2D since
+  /// 2026-11-27, 2 before; 2 in 3D).
+  double step_growth = 0;
   /// Displacement control: abandon an intermediate increment at its first iterate that leaves
   /// the path (off_the_path) instead of letting Newton creep there. Off by default: it saves a
   /// tenth of the Newton iterations of Random2D P2 paths, but loses load cases at bifurcations.
