@@ -202,8 +202,8 @@ std::string petsc_help_intro() {
       "Datasets); every key is validated.\n"
       "  solver:  rtol {:g}, max_newton {}, max_increments {}, target_rtol {:g}, control displacement|load "
       "({}), path_rtol {:g},\n"
-      "           newton_budget {}, fallback {}, branch_switches {}, step_growth {:g} (0: by dimension), abandon_off_path {}, factor_reuse {}, "
-      "krylov_budget {} (0: by dimension), krylov_rtol {:g},\n"
+      "           newton_budget {}, fallback {}, branch_switches {}, step_growth {:g} (0: by dimension), "
+      "abandon_off_path {}, factor_reuse {}, krylov_budget {} (0: by dimension), krylov_rtol {:g},\n"
       "           linear auto|direct|gamg|hypre ({}; auto: gamg in 3D from linear_auto_dofs {} unknowns)\n"
       "  petsc:   any PETSc option listed below, without the dash (the command line wins)\n"
       "  `hypershape effects` lists the effects a scene may use.\n",

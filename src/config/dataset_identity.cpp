@@ -50,7 +50,8 @@ std::string solver_text(const solver::SolverOptions& s) {
       num(s.rtol), num(s.atol), int(s.control), num(s.path_rtol), s.newton_budget, s.fallback, s.branch_switches,
       s.max_halvings, s.max_newton, s.tangent.reuse, s.tangent.krylov_budget, num(s.tangent.krylov_rtol),
       s.max_increments, num(s.min_increment), s.guard, num(s.target_rtol), s.max_target_solves) +
-         linear + (s.step_growth != solver::SolverOptions{}.step_growth ? "  step_growth: " + num(s.step_growth) + "\n" : "") +
+         linear +
+         (s.step_growth != solver::SolverOptions{}.step_growth ? "  step_growth: " + num(s.step_growth) + "\n" : "") +
          (s.abandon_off_path ? "  abandon_off_path: true\n" : "") +  // likewise only when asked for
          (s.arc_length_rescue ? "" : "  arc_length_rescue: false\n") +  // only when turned off
          (s.tangent.single_factor ? "  factor_precision: single\n" : "");

@@ -460,6 +460,7 @@ TargetResult NonlinearSolver::path(double target, double start, int spent, PathS
   double step = first_step(target, d, fresh);
   bool first_accepted = true;
   int failed_in_a_row = 0;
+  const double growth = step_growth(opt_.step_growth, problem_.space().dim());
   // Increments below 1e-3 of the way (or min_increment, if larger) are a stalled path: it
   // creeps along a limit point (measured: the budget spent on increments of 1e-4 of the way).
   const double min_step = std::abs(target - d) * std::max(opt_.min_increment, 1e-3);
@@ -491,7 +492,7 @@ TargetResult NonlinearSolver::path(double target, double start, int spent, PathS
       first_accepted = false;
       d = d_next;
       if (last) break;
-      step = next_step(step, its - its_before, step_growth(opt_.step_growth, problem_.space().dim()));
+      step = next_step(step, its - its_before, growth);
       continue;
     }
     ++t.failed_increments;
@@ -546,6 +547,7 @@ TargetResult NonlinearSolver::arc_path(double target, double start) {
   const double min_step = 1e-3 * target * scale;
   arc_ = true;
   int failed_in_a_row = 0;
+  const double growth = step_growth(opt_.step_growth, problem_.space().dim());
   bool crossed = false, landing = false;
   while (true) {
     if (its >= opt_.newton_budget) {
@@ -604,7 +606,7 @@ TargetResult NonlinearSolver::arc_path(double target, double start) {
     HS_PETSC(VecWAXPY(arc_dir_, -1.0, backup_, u_));
     PetscReal len;
     HS_PETSC(VecNormalize(arc_dir_, &len));
-    step = next_step(step, its - its_before, step_growth(opt_.step_growth, problem_.space().dim()));
+    step = next_step(step, its - its_before, growth);
   }
   arc_ = false;
   if (!crossed) {
