@@ -141,7 +141,7 @@ TEST_CASE("A target on the unstable segment of a fold is reported as a fold", "[
     c.set(load_id);
     const auto r = ns.solve_for_target(target);
     INFO("alone, no switch: " << r.reason);
-    // Found by the path itself, or by the arc-length rescue after it (31337/4/30 with the step
+    // Found by the path itself, or by the arc-length rescue after it (777/10/28 with the step
     // growth of 1.5 spends its Newton budget near the limit point first).
     REQUIRE(r.reason.find("fold: max|u| = target lies on an unstable segment of the path") != std::string::npos);
     const physics::Problem& p = *c.sp.problem;
