@@ -5,7 +5,7 @@
 /// Its pieces, one file each (src/solver/): nonlinear.cpp (set-up, the SNES callbacks, the guarded
 /// line search, solve_for_target), load_control.cpp (Newton at a given load, continuation, the
 /// alpha search of control: load), path_following.cpp (displacement control: predictor,
-/// corrector, the final check), branch_switch.cpp (softest mode, energy minimisation); the
+/// corrector, the final check), branch_switch.cpp (the tangent's modes, energy minimisation); the
 /// tangent, its factors and Krylov solves in tangent.hpp. Each registers PETSc log events
 /// (HSLoadControl, HSPredictor, HSCorrector, HSBranchSwitch, HSTangentAsm, HSFactor, ...), so
 /// -log_view splits a load case by piece.
@@ -307,10 +307,11 @@ class NonlinearSolver {
   void pseudo_random_vector(Vec v);
   /// All linear-algebra work so far (the path's tangent and the SNES's).
   LinearCounters linear_counters() const;
-  /// After a failed path: leaves the state the path ended in (unstable, or where increments
-  /// kept failing) along the tangent's softest mode, minimises the energy there at 0.7^attempt
-  /// times its load (a stable state on another branch: past a subcritical bifurcation none is
-  /// near at the full load), and follows that branch to the target. Adds its cost to `t`.
+  /// After a failed path: leaves the state the path ended in (unstable on target: along the
+  /// tangent's lowest mode; where increments kept failing: along its mode nearest zero),
+  /// minimises the energy there at 0.7^attempt times its load (a stable state on another
+  /// branch: past a subcritical bifurcation none is near at the full load), and follows that
+  /// branch to the target. Adds its cost to `t`.
   /// Measured on the 8 load cases lost on unseen seeds (777, 2024, 31337; issue 23): 6 end at a
   /// limit point of the load, not a bifurcation. There the switch's minimisation reaches either
   /// the stable state below the fold or the snapped-through one beyond it, and the path from
@@ -323,15 +324,22 @@ class NonlinearSolver {
   /// The eigenvector of K(u_) whose eigenvalue is nearest zero (inverse iteration from a
   /// rank-independent pseudo-random vector), in v_, |v_|_inf = 1; returns its Rayleigh quotient.
   double softest_mode();
+  /// A thousandth of the mean diagonal of the assembled K(u_): the first trial shift.
+  double shift_scale();
+  /// With K(u_) assembled and factorised with negative pivots: shifts it to K + mu I, the first
+  /// of -2 lam (where the mode nearest zero is negative) or mu0, 4 mu0, ... whose LDL^T has
+  /// no negative pivot, and finds K's lowest mode (v_, |v_|_inf = 1) and its Rayleigh quotient
+  /// lam. False if no shift factorised.
+  bool shift_past_lowest_mode(double mu0, double& mu, double& lam);
   /// Minimises the energy at load factor s from u_ by a trust-region Newton method: steps of at
   /// most `radius` (|.|_inf; from `eps`, doubled after full steps that filled it, cut to what
   /// the guarded line search took), through curvature_step where K(u_) is indefinite. Ends at
   /// an equilibrium whose tangent is positive definite, or returns false with `why`.
   bool minimise(double s, double eps, int& its, std::string& why);
   /// With K(u_) assembled and factorised (`negative` negative pivots) and R in r_: the step
-  /// u_ - du_. Indefinite K: shifted past the softest mode's eigenvalue (mu0, 4 mu0, ... where
-  /// that estimate is not negative) until LDL^T has no negative pivot, plus a move along the mode
-  /// (energy-descending sign) that fills the trust region. False if no shift factorised.
+  /// u_ - du_. Indefinite K: shifted past its lowest eigenvalue (shift_past_lowest_mode), plus a
+  /// move along that mode (energy-descending sign) that fills the trust region. False if no
+  /// shift factorised.
   bool curvature_step(double radius, double mu0, int negative);
 
   const physics::Problem& problem_;
