@@ -802,26 +802,54 @@ def check_dataset(path, out=sys.stdout):
     return problems
 
 
+OUTCOMES = ("path", "branch switch from an unstable state", "branch switch after a stall",
+            "arc-length rescue", "other", "failed")
+
+
+def load_case_outcome(status, reason):
+    """How a load case's solve ended, from its stored status and reason (docs/FORMAT.md): on the
+    path itself, after a branch switch from an unstable state on target (a bifurcation or a
+    fold) or from a stalled path, by the arc-length rescue, otherwise converged, or failed."""
+    if not status:
+        return "failed"
+    if reason == "target reached":
+        return "path"
+    if reason.startswith("target reached after a branch switch ("):
+        unstable = reason.startswith(("target reached after a branch switch (loss of stability",
+                                      "target reached after a branch switch (fold"))
+        return "branch switch from an unstable state" if unstable else "branch switch after a stall"
+    if reason.startswith("target reached by arc-length continuation"):
+        return "arc-length rescue"
+    return "other"
+
+
 def solver_report(path):
     """Solver outcomes of a dataset: load cases converged, failures grouped by reason, Newton
-    iterations per load case and the cost of recovery (iterations spent in failed increments).
-    Returns a dict (JSON-ready)."""
+    iterations per load case, the cost of recovery (iterations spent in failed increments) and
+    the load cases and Newton iterations by outcome (load_case_outcome). Returns a dict
+    (JSON-ready)."""
     ds = open_dataset(path)
     its, rec, inc, fails, status = [], [], [], {}, []
+    by = {o: {"load_cases": 0, "newton_iterations": 0} for o in OUTCOMES}
     for sid in ds.shape_ids(include_failed=True):
         sh = ds.shape(sid)
         if not sh.ok:
             for r in sh.reasons:
                 status.append(0)
+                by["failed"]["load_cases"] += 1
                 key = re.sub(r"[-+]?\d+(\.\d+)?(e[-+]?\d+)?", "#", r)
                 fails[key] = fails.get(key, 0) + 1
             continue
         g = ds._group(sid)["loads"]
-        its += list(g["newton_iterations"][...])
+        shape_its = [int(x) for x in g["newton_iterations"][...]]
+        its += shape_its
         rec += list(g["recovery_iterations"][...]) if "recovery_iterations" in g else [0] * len(sh.reasons)
         inc += list(g["solves"][...])
         for k, r in enumerate(sh.reasons):
             status.append(int(sh.status[k]))
+            o = by[load_case_outcome(sh.status[k], r)]
+            o["load_cases"] += 1
+            o["newton_iterations"] += shape_its[k]
             if not sh.status[k]:
                 key = re.sub(r"[-+]?\d+(\.\d+)?(e[-+]?\d+)?", "#", r)  # numbers out: group by kind
                 fails[key] = fails.get(key, 0) + 1
@@ -838,7 +866,8 @@ def solver_report(path):
             "increments_per_load_case_mean": float(np.mean(inc)) if inc else 0.0,
             "recovery_iterations": {"total": int(rec.sum()),
                                     "share_of_newton_iterations": float(rec.sum() / max(its.sum(), 1)),
-                                    "load_cases_with_recovery": int((rec > 0).sum())}}
+                                    "load_cases_with_recovery": int((rec > 0).sum())},
+            "by_outcome": {o: v for o, v in by.items() if v["load_cases"]}}
 
 
 def print_solver_report(r, out=sys.stdout):
@@ -850,6 +879,10 @@ def print_solver_report(r, out=sys.stdout):
       f"{r['increments_per_load_case_mean']:.1f} increments per load case")
     w(f"  recovery (iterations in failed increments): {rc['total']} = {100 * rc['share_of_newton_iterations']:.1f}% "
       f"of all, in {rc['load_cases_with_recovery']} load cases")
+    by = r.get("by_outcome", {})
+    if by:
+        w("  by outcome (load cases, Newton iterations each): " + "; ".join(
+            f"{o} {v['load_cases']} ({v['newton_iterations'] / v['load_cases']:.1f})" for o, v in by.items()))
     for reason, k in r["failures_by_reason"].items():
         w(f"  failed {k:>5} x  {reason}")
 

@@ -363,6 +363,40 @@ def cli(path, work):
     check(r.returncode != 0 and "missing" in r.stdout, "check fails when a shard is missing")
 
 
+def solver_outcomes(path):
+    """solver_report's split by outcome adds up, and load_case_outcome reads the solver's reasons
+    (their wording is checked against the C++ that writes them)."""
+    r = hd.solver_report(path)
+    by = r["by_outcome"]
+    check(sum(v["load_cases"] for v in by.values()) == r["load_cases"]
+          and by.get("failed", {"load_cases": 0})["load_cases"] == r["load_cases"] - r["converged"]
+          and sum(v["newton_iterations"] for v in by.values()) == r["newton_iterations"]["total"],
+          f"solver report by outcome adds up to the load cases, failures and Newton iterations: {by}")
+    reasons = {
+        (1, "target reached"): "path",
+        (1, "target reached after a branch switch (loss of stability at max|u| = 0.27, alpha = 24.4: "
+            "the tangent has 1 negative eigenvalue(s) (buckling or a bifurcation))"): "branch switch from an unstable state",
+        (1, "target reached after a branch switch (fold: max|u| = target lies on an unstable segment of "
+            "the path (...))"): "branch switch from an unstable state",
+        (1, "target reached after a branch switch (increment below minimum or too many increments (last: "
+            "no progress in 4 Newton iterations))"): "branch switch after a stall",
+        (1, "target reached by arc-length continuation (before: Newton budget of 200 iterations spent)"):
+            "arc-length rescue",
+        (1, "target reached by load control (displacement control: ...)"): "other",
+        (0, "target reached"): "failed",
+    }
+    got = {k: hd.load_case_outcome(*k) for k in reasons}
+    check(got == reasons, f"load_case_outcome classes the solver's reasons: {got}")
+    cpp = "".join(open(os.path.join(src, "src", "solver", f)).read()
+                  for f in ("branch_switch.cpp", "path_following.cpp", "nonlinear.cpp"))
+    written = ['"target reached after a branch switch ("', '"loss of stability at max|u| = "',
+               '"fold: max|u| = target lies on an unstable segment', '"target reached by arc-length continuation',
+               '"target reached"']
+    check(all(w in cpp for w in written), "the reasons load_case_outcome reads are the ones src/solver writes")
+    out = subprocess.run([sys.executable, script, "solver", path], capture_output=True, text=True).stdout
+    check("by outcome (load cases, Newton iterations each): path " in out, "`solver` prints the split by outcome")
+
+
 with tempfile.TemporaryDirectory() as work:
     paths = {name: generate(work, name) for name in CONFIGS}
     if all(paths.values()):
@@ -378,6 +412,8 @@ with tempfile.TemporaryDirectory() as work:
             metrics(hd.open_dataset(paths[name]))
         torch_part([paths["t2d"], paths["t3d"]])
         cli(paths["t2d"], work)
+        for name in ("t2d", "failing"):
+            solver_outcomes(paths[name])
         r = subprocess.run([sys.executable, script, "check", paths["t3d"]], capture_output=True, text=True)
         with h5py.File(os.path.join(paths["t3d"], "shards", "shard-000000.h5")) as f:
             iso = [g.attrs["isoperimetric_ratio"] for g in f["shapes"].values()]
