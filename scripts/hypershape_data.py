@@ -803,7 +803,7 @@ def check_dataset(path, out=sys.stdout):
 
 
 OUTCOMES = ("path", "branch switch from an unstable state", "branch switch after a stall",
-            "arc-length rescue", "other", "failed")
+            "arc-length rescue", "other", "failed", "shape failed")
 
 
 def load_case_outcome(status, reason):
@@ -826,8 +826,8 @@ def load_case_outcome(status, reason):
 def solver_report(path):
     """Solver outcomes of a dataset: load cases converged, failures grouped by reason, Newton
     iterations per load case, the cost of recovery (iterations spent in failed increments) and
-    the load cases and Newton iterations by outcome (load_case_outcome). Returns a dict
-    (JSON-ready)."""
+    the load cases and Newton iterations by outcome (load_case_outcome; "shape failed": the load
+    cases of a shape that was never solved, without iterations). Returns a dict (JSON-ready)."""
     ds = open_dataset(path)
     its, rec, inc, fails, status = [], [], [], {}, []
     by = {o: {"load_cases": 0, "newton_iterations": 0} for o in OUTCOMES}
@@ -836,7 +836,7 @@ def solver_report(path):
         if not sh.ok:
             for r in sh.reasons:
                 status.append(0)
-                by["failed"]["load_cases"] += 1
+                by["shape failed"]["load_cases"] += 1
                 key = re.sub(r"[-+]?\d+(\.\d+)?(e[-+]?\d+)?", "#", r)
                 fails[key] = fails.get(key, 0) + 1
             continue
@@ -882,7 +882,8 @@ def print_solver_report(r, out=sys.stdout):
     by = r.get("by_outcome", {})
     if by:
         w("  by outcome (load cases, Newton iterations each): " + "; ".join(
-            f"{o} {v['load_cases']} ({v['newton_iterations'] / v['load_cases']:.1f})" for o, v in by.items()))
+            f"{o} {v['load_cases']}" + ("" if o == "shape failed" else f" ({v['newton_iterations'] / v['load_cases']:.1f})")
+            for o, v in by.items()))
     for reason, k in r["failures_by_reason"].items():
         w(f"  failed {k:>5} x  {reason}")
 

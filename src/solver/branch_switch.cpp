@@ -68,7 +68,7 @@ bool NonlinearSolver::shift_past_lowest_mode(double mu0, double& mu, double& lam
   // K + mu I with no negative pivot: mu = -2 lam where the mode nearest zero is K's negative
   // one, else mu0, 4 mu0, ... Where it was not, the mode nearest zero is a positive one (a soft
   // mode of the body: at the unstable states of 11 Random2D switches replayed it always was,
-  // Rayleigh quotients 0.016-0.075; lowest eigenvalues -8 to -650 where printed), and inverse
+  // Rayleigh quotients 0.016-0.075; lowest eigenvalues -106 to -1988), and inverse
   // iteration with the definite K + mu I finds K's lowest mode instead.
   mu = 0;
   lam = softest_mode();  // v_; the factor in use is of K itself

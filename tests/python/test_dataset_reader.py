@@ -369,7 +369,9 @@ def solver_outcomes(path):
     r = hd.solver_report(path)
     by = r["by_outcome"]
     check(sum(v["load_cases"] for v in by.values()) == r["load_cases"]
-          and by.get("failed", {"load_cases": 0})["load_cases"] == r["load_cases"] - r["converged"]
+          and sum(by.get(o, {"load_cases": 0})["load_cases"] for o in ("failed", "shape failed"))
+          == r["load_cases"] - r["converged"]
+          and by.get("shape failed", {"newton_iterations": 0})["newton_iterations"] == 0
           and sum(v["newton_iterations"] for v in by.values()) == r["newton_iterations"]["total"],
           f"solver report by outcome adds up to the load cases, failures and Newton iterations: {by}")
     reasons = {
