@@ -43,7 +43,7 @@ int main(int argc, char** argv) {
   app.add_option("--grid3d", set.grid3d, "3D grid nodes per axis")->check(CLI::Range(2, 512));
   app.add_option("--json", set.json_path, "also write the results (medians + per-id values) here");
   try {
-    app.parse(int(ours.size()), ours.data());
+    app.parse(ours.count(), ours.data());
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }
@@ -52,7 +52,7 @@ int main(int argc, char** argv) {
     for (const char* n : {"random2d", "easy_random2d", "ood_random2d", "one_random2d", "random3d", "aug_liver"})
       set.presets.push_back(fmt::format("configs/presets/{}.yaml", n));
 
-  int petsc_argc = int(petsc.size());
+  int petsc_argc = petsc.count();
   char** petsc_argv = petsc.data();
   try {
     hs::core::PetscSession petsc_session(&petsc_argc, &petsc_argv, "bench_shapes\n");

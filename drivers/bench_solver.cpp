@@ -54,14 +54,14 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_option("--json", set.json_path, "write the results here (default: stdout after the tables)");
   try {
-    app.parse(int(ours.size()), ours.data());
+    app.parse(ours.count(), ours.data());
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }
   if (!hs::study::output_writable(set.json_path, "--json")) return 2;
   set.petsc_args.assign(petsc.begin() + 1, petsc.end());
 
-  int petsc_argc = int(petsc.size());
+  int petsc_argc = petsc.count();
   char** petsc_argv = petsc.data();
   int my_rank = 0;
   try {

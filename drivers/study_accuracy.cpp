@@ -91,7 +91,7 @@ int main(int argc, char** argv) {
   app.add_option("--sizes2d", a.sizes2d, "2D mesh sizes of the h x degree grid (full)")->check(CLI::PositiveNumber);
   app.add_option("--sizes3d", a.sizes3d, "3D mesh sizes of the h x degree grid (full)")->check(CLI::PositiveNumber);
   try {
-    app.parse(int(ours.size()), ours.data());
+    app.parse(ours.count(), ours.data());
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }
@@ -99,7 +99,7 @@ int main(int argc, char** argv) {
   hs::study::apply_defaults(a);
   a.petsc_args.assign(petsc.begin() + 1, petsc.end());
 
-  int petsc_argc = int(petsc.size());
+  int petsc_argc = petsc.count();
   char** petsc_argv = petsc.data();
   try {
     hs::core::PetscSession petsc_session(&petsc_argc, &petsc_argv, help_text);

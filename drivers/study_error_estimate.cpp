@@ -38,12 +38,12 @@ int main(int argc, char** argv) {
   app.add_flag("--estimate-only", estimate_only, "no references: solve and estimate only (the estimate's cost and values)");
   app.add_option("--out", out_file, "JSON lines output (default stdout); appended to");
   try {
-    app.parse(int(ours.size()), ours.data());
+    app.parse(ours.count(), ours.data());
     o.references = !estimate_only;
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }
-  int pargc = int(petsc.size());
+  int pargc = petsc.count();
   char** pargv = petsc.data();
   try {
     hs::core::PetscSession petsc_session(&pargc, &pargv, nullptr);

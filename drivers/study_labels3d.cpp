@@ -39,12 +39,12 @@ int main(int argc, char** argv) {
   app.add_option("--out", out, "JSON results");
   app.add_option("--write", o.write_dir, "write every solution to DIR/<scene>_<name>.h5 (scripts/check_labels3d_dolfinx.py reads them)");
   try {
-    app.parse(int(ours.size()), ours.data());
+    app.parse(ours.count(), ours.data());
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }
   if (!hs::study::output_writable(out, "--out")) return 2;
-  int petsc_argc = int(petsc.size());
+  int petsc_argc = petsc.count();
   char** petsc_argv = petsc.data();
   try {
     for (const auto& s : specs) o.discretisations.push_back(hs::study::labels3d::parse_discretisation(s));

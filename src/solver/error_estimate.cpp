@@ -457,6 +457,8 @@ bool TwoLevelEstimator::fine_newton(Vec Pu, double alpha, Vec e, ErrorEstimate& 
   for (int it = 0; it < 4 && (it == 0 || !full_step || newton_to_tolerance_) && rn > 1e-2 * r0; ++it) {
     bool fell_back = false;
     const double lambda = fine_step(x, r, alpha, it == 0, fell_back, out);
+    HS_PETSC(PetscInfo(ksp_.get(), "error estimate: fine Newton step %d: |R| %g (first %g), step length %g%s\n", it,
+                       double(rn), double(r0), lambda, fell_back ? " (the preconditioner's step)" : ""));
     if (lambda < 0) return false;
     const bool accepted = lambda > 0;
     full_step = full_step && lambda == 1.0 && !fell_back;

@@ -12,7 +12,9 @@
 namespace hypershape::study {
 
 SplitArgs split_at_dashes(int argc, char** argv) {
-  SplitArgs s{{argv[0]}, {argv[0]}};
+  SplitArgs s;
+  s.ours.push_back(argv[0]);
+  s.petsc.push_back(argv[0]);
   bool after = false;
   for (int i = 1; i < argc; ++i) {
     if (!after && std::string(argv[i]) == "--") {

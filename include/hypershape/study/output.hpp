@@ -8,9 +8,19 @@
 
 namespace hypershape::study {
 
+/// An argument vector: argv[0] first and a null pointer after the last argument (argv[argc] ==
+/// NULL: MPI_Init walks argv to it; without it Open MPI read past the end and crashed).
+struct Argv {
+  std::vector<char*> args{nullptr};
+  int count() const { return int(args.size()) - 1; }
+  char** data() { return args.data(); }
+  char** begin() { return args.data(); }
+  char** end() { return args.data() + count(); }  ///< the arguments only, not the null pointer
+  void push_back(char* a) { args.insert(args.end() - 1, a); }
+};
 /// argv split at the first "--": `ours` and `petsc`, each starting with argv[0].
 struct SplitArgs {
-  std::vector<char*> ours, petsc;
+  Argv ours, petsc;
 };
 SplitArgs split_at_dashes(int argc, char** argv);
 
