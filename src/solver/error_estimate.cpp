@@ -13,6 +13,7 @@
 #include "hypershape/core/vec_array.hpp"
 #include "hypershape/mesh/reference_cell.hpp"
 #include "hypershape/solver/ldlt.hpp"
+#include "log_events.hpp"
 
 namespace hypershape::solver {
 
@@ -104,57 +105,72 @@ void broadcast(std::vector<T>& v, MPI_Datatype type, MPI_Comm comm) {
   MPI_Bcast(v.data(), int(n), type, 0, comm);
 }
 
+/// M_ab = int_T N_a N_b / |T| for the P1/P2 basis (VTK order): the same matrix on every
+/// straight-sided simplex, so u^2 integrates exactly as |T| c^T M c (c: the cell's nodal values).
+std::vector<double> mean_mass_matrix(int dim, int degree) {
+  const int nv = dim + 1, npc = mesh::nodes_per_cell(dim, degree);
+  // N_a = sum_ij C^a_ij l_i l_j, homogeneous in the barycentric l (sum l = 1): P1's l_a is
+  // l_a sum_j l_j; P2's vertex function l_a (2 l_a - 1) = l_a^2 - sum_{b != a} l_a l_b, its
+  // edge function 4 l_a l_b. Then int N_a N_b / |T| = sum C^a_ij C^b_qr mean(l_i l_j l_q l_r).
+  using Coefficients = std::array<std::array<double, 4>, 4>;
+  std::vector<Coefficients> C(static_cast<std::size_t>(npc), Coefficients{});
+  for (int a = 0; a < nv; ++a)
+    for (int b = 0; b < nv; ++b) {
+      auto& c = C[std::size_t(a)];
+      if (degree == 1) {
+        c[std::size_t(a)][std::size_t(b)] += 0.5, c[std::size_t(b)][std::size_t(a)] += 0.5;
+      } else if (b == a) {
+        c[std::size_t(a)][std::size_t(a)] += 1;
+      } else {
+        c[std::size_t(a)][std::size_t(b)] -= 0.5, c[std::size_t(b)][std::size_t(a)] -= 0.5;
+      }
+    }
+  if (degree == 2) {
+    int e = nv;
+    for (const auto& [a, b] : mesh::edges(dim)) {
+      auto& c = C[std::size_t(e++)];
+      c[std::size_t(a)][std::size_t(b)] = c[std::size_t(b)][std::size_t(a)] = 2;
+    }
+  }
+  std::vector<double> M(std::size_t(npc * npc), 0.0);
+  for (int x = 0; x < npc; ++x)
+    for (int y = 0; y < npc; ++y)
+      for (int i = 0; i < nv; ++i)
+        for (int j = 0; j < nv; ++j)
+          for (int q = 0; q < nv; ++q)
+            for (int r = 0; r < nv; ++r) {
+              std::array<int, 4> m{};
+              ++m[std::size_t(i)], ++m[std::size_t(j)], ++m[std::size_t(q)], ++m[std::size_t(r)];
+              M[std::size_t(x * npc + y)] += C[std::size_t(x)][std::size_t(i)][std::size_t(j)] *
+                                             C[std::size_t(y)][std::size_t(q)][std::size_t(r)] * monomial_mean(dim, m);
+            }
+  return M;
+}
+
 }  // namespace
 
 std::vector<double> l2_norms_squared(int dim, int degree, const std::vector<double>& coords,
                                      const std::vector<std::int64_t>& cells,
                                      const std::vector<const std::vector<double>*>& fields, int n_comp) {
-  const int nv = dim + 1, npc = mesh::nodes_per_cell(dim, degree);
-  // u = sum_ij C_ij l_i l_j (P2, homogeneous in the barycentric l since sum l = 1) or
-  // sum_i c_i l_i (P1); u^2 integrates exactly through the monomial means.
-  std::vector<double> m2(std::size_t(nv * nv)), m4(std::size_t(nv * nv * nv * nv));
-  for (int i = 0; i < nv; ++i)
-    for (int j = 0; j < nv; ++j) {
-      std::array<int, 4> a{};
-      ++a[std::size_t(i)], ++a[std::size_t(j)];
-      m2[std::size_t(i * nv + j)] = monomial_mean(dim, a);
-      for (int k = 0; k < nv; ++k)
-        for (int l = 0; l < nv; ++l) {
-          std::array<int, 4> b = a;
-          ++b[std::size_t(k)], ++b[std::size_t(l)];
-          m4[std::size_t(((i * nv + j) * nv + k) * nv + l)] = monomial_mean(dim, b);
-        }
-    }
-  // int_T u^2 / |T| of one component of one field.
-  auto cell_mean_square = [&](const std::vector<double>& field, const std::int64_t* v, int k) {
-    auto val = [&](int a) { return field[std::size_t(v[a] * n_comp + k)]; };
-    double s = 0;
-    if (degree == 1) {
-      for (int i = 0; i < nv; ++i)
-        for (int j = 0; j < nv; ++j) s += val(i) * val(j) * m2[std::size_t(i * nv + j)];
-      return s;
-    }
-    double C[4][4] = {};
-    for (int a = 0; a < nv; ++a) {
-      C[a][a] += val(a);
-      for (int b = 0; b < nv; ++b)
-        if (b != a) C[a][b] -= 0.5 * val(a), C[b][a] -= 0.5 * val(a);
-    }
-    int e = nv;
-    for (const auto& [a, b] : mesh::edges(dim)) C[a][b] += 2 * val(e), C[b][a] += 2 * val(e), ++e;
-    for (int i = 0; i < nv; ++i)
-      for (int j = 0; j < nv; ++j)
-        for (int q = 0; q < nv; ++q)
-          for (int r = 0; r < nv; ++r) s += C[i][j] * C[q][r] * m4[std::size_t(((i * nv + j) * nv + q) * nv + r)];
-    return s;
-  };
+  const int npc = mesh::nodes_per_cell(dim, degree);
+  const std::vector<double> M = mean_mass_matrix(dim, degree);
   std::vector<double> total(fields.size(), 0.0);
   const std::size_t n_cells = cells.size() / std::size_t(npc);
-  for (std::size_t c = 0; c < n_cells; ++c) {
-    const std::int64_t* v = &cells[c * std::size_t(npc)];
+  double c[10];
+  for (std::size_t cell = 0; cell < n_cells; ++cell) {
+    const std::int64_t* v = &cells[cell * std::size_t(npc)];
     const double vol = cell_measure(dim, coords, v);  // once for all fields
     for (std::size_t f = 0; f < fields.size(); ++f)
-      for (int k = 0; k < n_comp; ++k) total[f] += vol * cell_mean_square(*fields[f], v, k);
+      for (int k = 0; k < n_comp; ++k) {
+        for (int a = 0; a < npc; ++a) c[a] = (*fields[f])[std::size_t(v[a] * n_comp + k)];
+        double s = 0;
+        for (int a = 0; a < npc; ++a) {
+          double row = 0;
+          for (int b = 0; b < npc; ++b) row += M[std::size_t(a * npc + b)] * c[b];
+          s += c[a] * row;
+        }
+        total[f] += vol * s;
+      }
   }
   return total;
 }
@@ -366,26 +382,28 @@ std::array<double, 6> estimate_values(const Space& fs, const std::vector<double>
 
 }  // namespace
 
-double TwoLevelEstimator::energy_search(Vec x, Vec dx, double alpha, Vec w, ErrorEstimate& out) const {
+double TwoLevelEstimator::energy_search(Vec x, double ex, Vec dx, double alpha, Vec w, double& ew,
+                                        ErrorEstimate& out) const {
   // Accept the largest step (halving) that lowers the potential energy: residual norms
   // rejected every step of one Random2D case, where the full step overshot 8x.
+  LogEvent logged(events().estimate_fine_assembly);
   const double t = MPI_Wtime();
-  double ex = 0, ew = 0, accepted = 0;
-  if (fine_.energy(x, alpha, ex))
-    for (double lambda = 1.0; lambda > 0.03 && accepted == 0; lambda *= 0.5) {
-      HS_PETSC(VecWAXPY(w, lambda, dx, x));
-      // (or leaves it at round-off: a u_h the fine space already solves has e = 0)
-      if (fine_.energy(w, alpha, ew) && (ew < ex || std::abs(ew - ex) <= 1e-12 * std::abs(ex))) accepted = lambda;
-    }
+  double accepted = 0;
+  for (double lambda = 1.0; lambda > 0.03 && accepted == 0; lambda *= 0.5) {
+    HS_PETSC(VecWAXPY(w, lambda, dx, x));
+    // (or leaves it at round-off: a u_h the fine space already solves has e = 0)
+    if (fine_.energy(w, alpha, ew) && (ew < ex || std::abs(ew - ex) <= 1e-12 * std::abs(ex))) accepted = lambda;
+  }
   out.seconds_assembly += MPI_Wtime() - t;
   return accepted;
 }
 
 namespace {
 
-/// f() timed into acc; its result.
+/// f() timed into acc and logged as `event`; its result.
 template <class F>
-bool timed(double& acc, F&& f) {
+bool timed(double& acc, PetscLogEvent event, F&& f) {
+  LogEvent logged(event);
   const double t = MPI_Wtime();
   const bool ok = f();
   acc += MPI_Wtime() - t;
@@ -394,16 +412,17 @@ bool timed(double& acc, F&& f) {
 
 }  // namespace
 
-double TwoLevelEstimator::fine_step(Vec x, Vec r, double alpha, bool first, bool& fell_back, ErrorEstimate& out) const {
+double TwoLevelEstimator::fine_step(Vec x, double ex, Vec r, double alpha, bool first, bool& fell_back, double& ew,
+                                    ErrorEstimate& out) const {
   Vec dx = fv_[2], w = fv_[3];
   out.tangent_assemblies += 1;
-  if (!timed(out.seconds_assembly, [&] { return fine_.jacobian(x, Kf_, alpha); })) {
+  if (!timed(out.seconds_assembly, events().estimate_fine_assembly, [&] { return fine_.jacobian(x, Kf_, alpha); })) {
     HS_PETSC(PetscInfo(ksp_.get(), "error estimate: fine tangent failed\n"));
     return -1;
   }
   HS_PETSC(KSPSetOperators(ksp_, Kf_, Kf_));
   HS_PETSC(VecScale(r, -1.0));
-  timed(out.seconds_linear, [&] {
+  timed(out.seconds_linear, events().estimate_fine_solve, [&] {
     HS_PETSC(KSPSolve(ksp_, r, dx));
     return true;
   });
@@ -417,7 +436,7 @@ double TwoLevelEstimator::fine_step(Vec x, Vec r, double alpha, bool first, bool
   // and the energy line search judges it as any step.
   if (reason == KSP_DIVERGED_ITS) out.krylov_budget_spent = true;
   if (reason <= 0 && reason != KSP_DIVERGED_ITS) return -1;
-  double lambda = energy_search(x, dx, alpha, w, out);
+  double lambda = energy_search(x, ex, dx, alpha, w, ew, out);
   fell_back = false;
   if (lambda == 0 && first) {
     // No descent along the Newton step of an indefinite fine tangent (two Random2D load cases
@@ -427,7 +446,7 @@ double TwoLevelEstimator::fine_step(Vec x, Vec r, double alpha, bool first, bool
     PC pc;
     HS_PETSC(KSPGetPC(ksp_, &pc));
     HS_PETSC(PCApply(pc, r, dx));
-    lambda = energy_search(x, dx, alpha, w, out);
+    lambda = energy_search(x, ex, dx, alpha, w, ew, out);
     fell_back = true;
   }
   return lambda;
@@ -437,7 +456,13 @@ bool TwoLevelEstimator::fine_newton(Vec Pu, double alpha, Vec e, ErrorEstimate& 
   Vec x = fv_[0], r = fv_[1], w = fv_[3], g = fv_[4];
   HS_PETSC(VecCopy(Pu, x));
   out.residual_assemblies += 1;
-  if (!timed(out.seconds_assembly, [&] { return fine_.residual(x, alpha, r); })) {
+  // The energy at x with its residual (one pass over the cells); after each step, the energy
+  // the line search accepted.
+  double ex = 0;
+  if (!timed(out.seconds_assembly, events().estimate_fine_assembly, [&] {
+        return fine_.conservative() ? fine_.energy_residual(x, alpha, ex, r)
+                                    : fine_.residual(x, alpha, r) && fine_.energy(x, alpha, ex);
+      })) {
     // The same field, sampled at other points of its cells: det F <= 0 there.
     out.inverted = true;
     HS_PETSC(PetscInfo(ksp_.get(), "error estimate: u_h inverts inside a cell (det F <= 0 at a refined-mesh quadrature point)\n"));
@@ -456,7 +481,8 @@ bool TwoLevelEstimator::fine_newton(Vec Pu, double alpha, Vec e, ErrorEstimate& 
   bool full_step = true;
   for (int it = 0; it < 4 && (it == 0 || !full_step || newton_to_tolerance_) && rn > 1e-2 * r0; ++it) {
     bool fell_back = false;
-    const double lambda = fine_step(x, r, alpha, it == 0, fell_back, out);
+    double ew = 0;
+    const double lambda = fine_step(x, ex, r, alpha, it == 0, fell_back, ew, out);
     HS_PETSC(PetscInfo(ksp_.get(), "error estimate: fine Newton step %d: |R| %g (first %g), step length %g%s\n", it,
                        double(rn), double(r0), lambda, fell_back ? " (the preconditioner's step)" : ""));
     if (lambda < 0) return false;
@@ -475,11 +501,12 @@ bool TwoLevelEstimator::fine_newton(Vec Pu, double alpha, Vec e, ErrorEstimate& 
       break;
     }
     out.residual_assemblies += 1;
-    if (!timed(out.seconds_assembly, [&] { return fine_.residual(w, alpha, g); })) return false;
+    if (!timed(out.seconds_assembly, events().estimate_fine_assembly, [&] { return fine_.residual(w, alpha, g); })) return false;
     HS_PETSC(VecNorm(g, NORM_2, &gn));
     HS_PETSC(VecSwap(x, w));
     HS_PETSC(VecSwap(r, g));  // (swaps the values: fv_ keeps its vectors)
     rn = gn;
+    ex = ew;
   }
   out.newton_steps_converged = rn <= 1e-2 * r0 || full_step;
   HS_PETSC(VecWAXPY(e, -1.0, Pu, x));
@@ -533,6 +560,7 @@ bool TwoLevelEstimator::prepare_coarse(Vec u_h, const CoarseSolve& coarse_solve,
 }
 
 ErrorEstimate TwoLevelEstimator::estimate(Vec u_h, double alpha, const CoarseSolve& coarse_solve) const {
+  LogEvent logged(events().estimate);
   ErrorEstimate out;
   const double t0 = MPI_Wtime();
   const Space& fs = fine_.space();
@@ -558,6 +586,7 @@ ErrorEstimate TwoLevelEstimator::estimate(Vec u_h, double alpha, const CoarseSol
   if (coarse_failed_) HS_PETSC(PetscInfo(ksp_.get(), "error estimate: the coarse solve failed\n"));
   ok = ok && !coarse_failed_;
   coarse_solve_ = nullptr;
+  LogEvent values(events().estimate_values);
   const std::vector<double> uc = coarse_.gather(u_h).values, ev = fine_.gather(e).values, av = coarse_.gather(a).values;
   std::array<double, 6> vals{};  // rel L2, raw rel L2, max, raw max, slope, ok
   if (core::rank(comm) == 0 && ok) vals = estimate_values(fs, prolong(uc), uc, ev, av, theta, alpha);

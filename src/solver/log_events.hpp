@@ -5,7 +5,10 @@
 /// HSPredictor / HSCorrector (the displacement-controlled path), HSBranchSwitch, HSLoadControl,
 /// HSAMGSetup (multigrid set-ups of a tangent), HSStability (the multigrid kind's LOBPCG check),
 /// HSFactorSingle (numeric single-precision factorisations, SMUMPS: not a PCSetUp),
-/// HSFactorBlocked (numeric factorisations of the 2D blocked LDL^T, BlockLdlt2: not a PCSetUp).
+/// HSFactorBlocked (numeric factorisations of the 2D blocked LDL^T, BlockLdlt2: not a PCSetUp);
+/// the labels' error estimate (TwoLevelEstimator): HSEstimate (one estimate), within it
+/// HSEstFineAsm (fine residuals, tangents, energies), HSEstFineSolve (the two-grid GMRES) and
+/// HSEstValues (the estimates from the fields: gathers, norms).
 #include <petsclog.h>
 
 namespace hypershape::solver {
@@ -13,6 +16,7 @@ namespace hypershape::solver {
 struct Events {
   PetscLogEvent tangent_assembly, factorisation, factor_solve, krylov, predictor, corrector,
       branch_switch, load_control, multigrid_setup, stability, single_factor, blocked_factor;
+  PetscLogEvent estimate, estimate_fine_assembly, estimate_fine_solve, estimate_values;
 };
 
 /// Registered on first use (PETSc must be initialised). Not collective.

@@ -125,6 +125,32 @@ TEST_CASE("Uniform refinement is nested and the prolongation exact", "[error_est
     }
 }
 
+TEST_CASE("The L2 norm of a field of the space is its exact integral", "[error_estimate]") {
+  // On the unit box: P1 u = (x, y + 1, z - x), P2 u = (x^2 + y, x y, z^2 - x), integrated by hand.
+  for (int dim : {2, 3})
+    for (int deg : {1, 2}) {
+      DYNAMIC_SECTION(dim << "D P" << deg) {
+        const mesh::MeshData m = mesh::mesh_box(dim, 1.0, dim == 2 ? 0.3 : 0.6);
+        std::vector<physics::EffectPtr> effects;
+        effects.push_back(physics::make_neo_hookean(500, 0.3));
+        physics::Problem problem(PETSC_COMM_WORLD, m, std::move(effects), hstest::degree(deg));
+        auto f = [deg](const double* x, double* u) {
+          u[0] = deg == 1 ? x[0] : x[0] * x[0] + x[1];
+          u[1] = deg == 1 ? x[1] + 1 : x[0] * x[1];
+          u[2] = deg == 1 ? x[2] - x[0] : x[2] * x[2] - x[0];
+        };
+        core::VecH u = problem.create_vector();
+        hstest::interpolate(problem, f, u);
+        const std::vector<double> values = problem.gather(u).values;
+        if (values.empty()) return;  // (rank > 0)
+        const auto& s = problem.space();
+        const double exact = deg == 1 ? (dim == 2 ? 8.0 / 3 : 17.0 / 6) : (dim == 2 ? 44.0 / 45 : 53.0 / 45);
+        CHECK(solver::l2_norm_squared(dim, deg, s.canonical_coords(), s.canonical_cells(), values, dim) ==
+              Approx(exact).epsilon(1e-13));
+      }
+    }
+}
+
 TEST_CASE("The estimate of a solution the space contains is zero", "[error_estimate]") {
   for (int deg : {1, 2}) {
     DYNAMIC_SECTION("2D P" << deg) {

@@ -97,14 +97,16 @@ class TwoLevelEstimator {
  private:
   /// Newton on the fine problem from P u_h (the two-grid solver set up): e = u_fine - P u_h.
   bool fine_newton(Vec Pu, double alpha, Vec e, ErrorEstimate& out) const;
-  /// One step of it from x (residual r, negated here): the tangent assembled, the step solved by
+  /// One step of it from x (energy ex, residual r, negated here): the tangent assembled, the step solved by
   /// the two-grid GMRES (fv_[2]), the energy line search (the new state in fv_[3]); at the
   /// `first` step, the preconditioner's own step where the Newton step has no descent
-  /// (`fell_back`). The step length, 0 for none, -1 if the assembly or the solve failed.
-  double fine_step(Vec x, Vec r, double alpha, bool first, bool& fell_back, ErrorEstimate& out) const;
-  /// The largest step lambda in {1, 1/2, ..., > 0.03} with E(x + lambda dx) <= E(x) (w: that
-  /// state), or 0. Energy evaluations counted in out.seconds_assembly.
-  double energy_search(Vec x, Vec dx, double alpha, Vec w, ErrorEstimate& out) const;
+  /// (`fell_back`). The step length, 0 for none, -1 if the assembly or the solve failed; `ew`: the
+  /// energy of the new state.
+  double fine_step(Vec x, double ex, Vec r, double alpha, bool first, bool& fell_back, double& ew,
+                   ErrorEstimate& out) const;
+  /// The largest step lambda in {1, 1/2, ..., > 0.03} with E(x + lambda dx) <= E(x) = ex (w: that
+  /// state, ew: its energy), or 0. Energy evaluations counted in out.seconds_assembly.
+  double energy_search(Vec x, double ex, Vec dx, double alpha, Vec w, double& ew, ErrorEstimate& out) const;
   /// The coarse level: y = K_c^-1 x by `coarse_` (the caller's factor) or by `direct_`.
   void coarse_apply(Vec x, Vec y, bool refined) const;
   static PetscErrorCode apply_coarse(PC pc, Vec x, Vec y);
