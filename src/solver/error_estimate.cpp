@@ -501,7 +501,8 @@ bool TwoLevelEstimator::fine_newton(Vec Pu, double alpha, Vec e, ErrorEstimate& 
       break;
     }
     out.residual_assemblies += 1;
-    if (!timed(out.seconds_assembly, events().estimate_fine_assembly, [&] { return fine_.residual(w, alpha, g); })) return false;
+    if (!timed(out.seconds_assembly, events().estimate_fine_assembly, [&] { return fine_.residual(w, alpha, g); }))
+      return false;
     HS_PETSC(VecNorm(g, NORM_2, &gn));
     HS_PETSC(VecSwap(x, w));
     HS_PETSC(VecSwap(r, g));  // (swaps the values: fv_ keeps its vectors)

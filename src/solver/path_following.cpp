@@ -250,7 +250,7 @@ bool NonlinearSolver::off_the_path(double rtol, double lambda) const {
   // increment before it did not fail): where the path itself turns indefinite (a bifurcation
   // ahead), its retries creep on as before rather than shrink to nothing. Not on the last
   // increment: its state on target is reached and classified (stable, or a fold).
-  // Measured side by side with the default (README, "How it solves"): Random2D P2 h 0.12, 8
+  // Measured side by side with the default (docs/SOLVER.md): Random2D P2 h 0.12, 8
   // shapes x 25 load cases on the unseen seeds 2024 and 777: Newton iterations per load case
   // 21.1 / 20.6 -> 19.0 / 19.0, the same 199 / 200 converged; Random2D P1 h 0.04, 1000 load
   // cases on each of the seeds 777, 2024, 31337: 14.9 / 11.7 / 13.7 -> 14.3 / 11.2 / 13.2, p99

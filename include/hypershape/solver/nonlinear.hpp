@@ -101,7 +101,7 @@ struct SolverOptions {
   /// itself stops growing along the path, and reach the target under displacement control from
   /// where max|u| crosses it. A budget of newton_budget iterations of its own. Only load cases
   /// that failed before it ran change (measured: 3000 Random2D load cases of unseen seeds, every
-  /// other array bit for bit; README, "Seeds nobody tuned on"). In 2D only: on the random3d
+  /// other array bit for bit; docs/STABILITY.md, "Seeds nobody tuned on"). In 2D only: on the random3d
   /// preset (seed 90210, 200 load cases) it rescued none (0 of 1) for 5% more Newton iterations.
   bool arc_length_rescue = true;
   /// The displacement-controlled path's linear solves: Newton-Krylov on a kept factorisation

@@ -14,7 +14,7 @@ namespace hypershape::solver {
 /// halving after >= 6: 12.6 (0.24 failed increments per load case against 0.34), all 200
 /// converged. Growing by 1.5 instead of 2 (issue 23, 1000 load cases on
 /// each of five unseen seeds, P1 and P2): 1-7.5% fewer Newton iterations, 13-39% fewer in
-/// discarded increments, the same converged share (README, "How it solves").
+/// discarded increments, the same converged share (docs/SOLVER.md).
 inline double next_step(double step, int n, double growth) {
   if (n <= 2) return growth * step;
   return n >= 6 ? 0.5 * step : step;
@@ -33,7 +33,7 @@ inline double step_growth(double configured, int dim) {
 /// of Newton's step and the residual did not halve over them. Such increments mostly failed
 /// later anyway (no convergence in max_newton, or no progress), after 4-9 more iterations at
 /// steps of 1e-3 or less; failing at once halves the increment sooner. Measured side by side
-/// (README, "How it solves").
+/// (docs/SOLVER.md).
 class CreepWatch {
  public:
   static constexpr int window = 3;           ///< steps looked at
