@@ -299,6 +299,9 @@ constexpr PetscInt kFineKrylovBudget = 40;
 core::KSPH two_grid_solver(MPI_Comm comm, Mat Kf, Mat Kc, Mat P, PetscErrorCode (*coarse_apply)(PC, Vec, Vec), void* ctx) {
   core::KSPH ksp;
   HS_PETSC(KSPCreate(comm, ksp.out()));
+  // The prefix before PCMGSetLevels: the levels' solvers take it when they are made (set after,
+  // the smoothers read the global -mg_levels_* options and not -error_estimate_mg_levels_*).
+  HS_PETSC(KSPSetOptionsPrefix(ksp, "error_estimate_"));
   HS_PETSC(KSPSetType(ksp, KSPGMRES));
   HS_PETSC(KSPSetOperators(ksp, Kf, Kf));
   // A budget of 40 unrestarted iterations; a step that spends it is kept (fine_step). On the
@@ -331,7 +334,6 @@ core::KSPH two_grid_solver(MPI_Comm comm, Mat Kf, Mat Kc, Mat P, PetscErrorCode 
   PC spc;
   HS_PETSC(KSPGetPC(smooth, &spc));
   HS_PETSC(PCSetType(spc, PCSOR));
-  HS_PETSC(KSPSetOptionsPrefix(ksp, "error_estimate_"));
   HS_PETSC(KSPSetFromOptions(ksp));
   return ksp;
 }

@@ -56,6 +56,22 @@ for cls in (ht.GridDataset, ht.PointCloudDataset):
     assert 0 < len(some) < len(all_) or len(all_) == 1, (len(some), len(all_))
     assert (some.error_estimates[:, 0] <= cut).all()
 PY
+# The fine solve's own options (prefix error_estimate_, its two-grid levels included) reach it: a
+# smoother option is read, not refused as unread, and changes the estimates but not the labels.
+"$bin" -q generate "$work/tiny.yaml" --progress 0 -o "$work/opt" -error_estimate_mg_levels_ksp_max_it 2 \
+  > "$work/opt.log" 2>&1 || { cat "$work/opt.log"; fail "-error_estimate_mg_levels_ksp_max_it refused"; }
+/usr/bin/python3 - "$work/ds" "$work/opt" <<'PY' && ok "-error_estimate_mg_levels_* options reach the fine solve's smoother" || fail "smoother options"
+import glob, h5py, numpy as np, sys
+def read(d, key):
+    out = []
+    for f in sorted(glob.glob(f"{d}/shards/*.h5")):
+        with h5py.File(f) as h:
+            out += [h["shapes"][s]["loads"][key][...].ravel() for s in sorted(h["shapes"])]
+    return np.concatenate(out)
+assert np.array_equal(read(sys.argv[1], "displacement"), read(sys.argv[2], "displacement"))
+a, b = read(sys.argv[1], "error_estimate_rel_l2"), read(sys.argv[2], "error_estimate_rel_l2")
+assert not np.array_equal(a, b), "the smoother option changed nothing"
+PY
 sed "s/, error_estimate: true//" "$work/tiny.yaml" > "$work/off.yaml"
 "$bin" -q generate "$work/off.yaml" --progress 0 -o "$work/off" || fail "generate without estimates"
 /usr/bin/python3 - "$work/off" <<'PY' && ok "by default: no estimate arrays" || fail "default: estimate arrays stored"
