@@ -823,6 +823,11 @@ def load_case_outcome(status, reason):
     return "other"
 
 
+def _reason_kind(reason):
+    """A failure reason with its numbers replaced by '#': failures grouped by kind."""
+    return re.sub(r"[-+]?\d+(\.\d+)?(e[-+]?\d+)?", "#", reason)
+
+
 def solver_report(path):
     """Solver outcomes of a dataset: load cases converged, failures grouped by reason, Newton
     iterations per load case, the cost of recovery (iterations spent in failed increments) and
@@ -837,7 +842,7 @@ def solver_report(path):
             for r in sh.reasons:
                 status.append(0)
                 by["shape failed"]["load_cases"] += 1
-                key = re.sub(r"[-+]?\d+(\.\d+)?(e[-+]?\d+)?", "#", r)
+                key = _reason_kind(r)
                 fails[key] = fails.get(key, 0) + 1
             continue
         g = ds._group(sid)["loads"]
@@ -851,7 +856,7 @@ def solver_report(path):
             o["load_cases"] += 1
             o["newton_iterations"] += shape_its[k]
             if not sh.status[k]:
-                key = re.sub(r"[-+]?\d+(\.\d+)?(e[-+]?\d+)?", "#", r)  # numbers out: group by kind
+                key = _reason_kind(r)
                 fails[key] = fails.get(key, 0) + 1
     ds.close()
     its, rec, status = np.array(its, float), np.array(rec, float), np.array(status)

@@ -328,8 +328,10 @@ class NonlinearSolver {
   double shift_scale();
   /// With K(u_) assembled and factorised with negative pivots: shifts it to K + mu I, the first
   /// of -2 lam (where the mode nearest zero is negative) or mu0, 4 mu0, ... whose LDL^T has
-  /// no negative pivot, and finds K's lowest mode (v_, |v_|_inf = 1) and its Rayleigh quotient
-  /// lam. False if no shift factorised.
+  /// no negative pivot. Where the mode nearest zero was positive, inverse iteration with that
+  /// definite factor then finds K's lowest mode; where it was negative, that mode (a direction of
+  /// negative curvature, not necessarily the lowest) is kept. In v_ (|v_|_inf = 1), its Rayleigh
+  /// quotient in lam. False if no shift factorised.
   bool shift_past_lowest_mode(double mu0, double& mu, double& lam);
   /// Minimises the energy at load factor s from u_ by a trust-region Newton method: steps of at
   /// most `radius` (|.|_inf; from `eps`, doubled after full steps that filled it, cut to what
