@@ -46,7 +46,7 @@ shapes:
   count: 4
 seed: 3
 name: same
-solver: {rtol: 1.0e-9, linear: auto, step_growth: 0, abandon_off_path: false, arc_length_rescue: true}
+solver: {rtol: 1.0e-9, linear: auto, step_growth: 0, abandon_off_path: false, arc_length_rescue: true, retry_from_rest: true}
 petsc: {}
 preset: random2d
 )") == a);
@@ -63,6 +63,7 @@ TEST_CASE("a different value is a different dataset", "[config][identity]") {
                              "mesh: {degree: 2}\n", "petsc: {pc_type: lu}\n", "output: {shard_size: 2}\n",
                              "solver: {linear: gamg}\n", "solver: {linear_auto_dofs: 1000}\n",
                              "solver: {abandon_off_path: true}\n", "solver: {arc_length_rescue: false}\n",
+                             "solver: {retry_from_rest: false}\n",
                              "solver: {step_growth: 2}\n"}) {
     std::string t = base;
     const std::string key = std::string(change).substr(0, std::string(change).find(':') + 1);

@@ -105,6 +105,38 @@ TEST_CASE("Replay one shape's load cases as the factory does", "[.][unseen_repla
   replay(c, ns, env_int("FROM", 0), env_int("LOAD", 47));
 }
 
+TEST_CASE("A load case lost on the hinted path is solved again from rest; the next one is unchanged",
+          "[stability][branch]") {
+  // Seed 777, shape 3, load 47 in the factory's order (from load 0, each path's first increment
+  // the previous load case's): that path and its switches end with the Newton budget spent
+  // (274 iterations); alone, from rest, the load case converges (157). retry_from_rest solves it
+  // so after the failed try, and leaves the next load case's hint as the failed try left it.
+  Case c(777, 3);
+  solver::SolverOptions off = c.cfg.solver;
+  off.retry_from_rest = false;
+  solver::NonlinearSolver without(*c.sp.problem, off);
+  const auto lost = replay(c, without, 0, 47);
+  CHECK_FALSE(lost.converged);
+  solver::NonlinearSolver with(*c.sp.problem, c.cfg.solver);
+  const auto r = replay(c, with, 0, 47);
+  INFO(r.reason);
+  CHECK(r.reason.rfind("target reached from rest without the first-increment hint (first try: ", 0) == 0);
+  CHECK(r.newton_iterations > lost.newton_iterations);  // the failed try counts, as recovery
+  CHECK(r.recovery_iterations >= lost.newton_iterations);
+  hstest::check_stable_on_target(*c.sp.problem, with.solution(), r, c.loads[47].target, c.cfg.solver);
+  // Load 48 after either: the same first increment, the same numbers.
+  const auto next_without = replay(c, without, 48, 48);
+  core::VecH u = c.sp.problem->create_vector();
+  HS_PETSC(VecCopy(without.solution(), u));
+  const auto next_with = replay(c, with, 48, 48);
+  REQUIRE(next_with.converged);
+  CHECK(next_with.alpha == next_without.alpha);
+  CHECK(next_with.newton_iterations == next_without.newton_iterations);
+  PetscBool same;
+  HS_PETSC(VecEqual(u, with.solution(), &same));
+  CHECK(same);
+}
+
 TEST_CASE("A stalled path rescued by a minimisation let finish ends stable on target", "[stability][branch]") {
   // Seed 777, shape 7, load 9 (replayed from load 0): the path stalls at max|u| 0.25 (tangent
   // positive definite, steps cut by the line search); the first branch switch's minimisation had

@@ -52,7 +52,9 @@
 ///   - a budget of newton_budget iterations per target solve (switches included) bounds the
 ///     cost of a failure;
 ///   - the arc-length rescue (arc_length_rescue) where the path and its switches failed (not at
-///     a verified fold): the load case again from rest by arc_path(), with a budget of its own.
+///     a verified fold): the load case again from rest by arc_path(), with a budget of its own;
+///   - a retry from rest without the first-increment hint (retry_from_rest) where all that failed
+///     on a path that started from the hint.
 /// Measured on 2 Random2D shapes x 20 load cases (P1, h 0.04): 18-25 Newton iterations per load
 /// case against 73-103 for the former strategy (control: load: load-controlled solves at
 /// secant-updated alpha), which stays available, as does a load-control fallback after a
@@ -104,6 +106,12 @@ struct SolverOptions {
   /// other array bit for bit; docs/STABILITY.md, "Seeds nobody tuned on"). In 2D only: on the random3d
   /// preset (seed 90210, 200 load cases) it rescued none (0 of 1) for 5% more Newton iterations.
   bool arc_length_rescue = true;
+  /// Displacement control failed (after the switches and the rescue; not at a verified fold) on
+  /// a path whose first increment was the previous load case's (the hint): solve it once more from
+  /// rest without the hint, with a budget of its own, as a load case solved alone would be.
+  /// The next load case's hint stays the one the first try left, so load cases that converged
+  /// are unchanged bit for bit (docs/SOLVER.md, "A retry from rest").
+  bool retry_from_rest = true;
   /// The displacement-controlled path's linear solves: Newton-Krylov on a kept factorisation
   /// (default) or a fresh factorisation per Newton iteration (tangent.reuse = false).
   TangentOptions tangent;
@@ -321,6 +329,9 @@ class NonlinearSolver {
   /// third attempt found one with a higher limit load, alpha 66.40 at max|u| 0.442 against 65.53,
   /// and ran out of the Newton budget on its last increment).
   void switch_branch(double target, double start, int attempt, TargetResult& t);
+  /// One try of solve_for_target: the path (or the alpha search), its branch switches, the
+  /// arc-length rescue and the load-control fallback, from the current state.
+  TargetResult attempt_target(double target, double start);
   /// The eigenvector of K(u_) whose eigenvalue is nearest zero (inverse iteration from a
   /// rank-independent pseudo-random vector), in v_, |v_|_inf = 1; returns its Rayleigh quotient.
   double softest_mode();
