@@ -803,13 +803,14 @@ def check_dataset(path, out=sys.stdout):
 
 
 OUTCOMES = ("path", "branch switch from an unstable state", "branch switch after a stall",
-            "arc-length rescue", "other", "failed", "shape failed")
+            "arc-length rescue", "retry from rest", "other", "failed", "shape failed")
 
 
 def load_case_outcome(status, reason):
     """How a load case's solve ended, from its stored status and reason (docs/FORMAT.md): on the
     path itself, after a branch switch from an unstable state on target (a bifurcation or a
-    fold) or from a stalled path, by the arc-length rescue, otherwise converged, or failed."""
+    fold) or from a stalled path, by the arc-length rescue, by the retry from rest without the
+    first-increment hint, otherwise converged, or failed."""
     if not status:
         return "failed"
     if reason == "target reached":
@@ -820,6 +821,8 @@ def load_case_outcome(status, reason):
         return "branch switch from an unstable state" if unstable else "branch switch after a stall"
     if reason.startswith("target reached by arc-length continuation"):
         return "arc-length rescue"
+    if reason.startswith("target reached from rest without the first-increment hint"):
+        return "retry from rest"
     return "other"
 
 

@@ -384,6 +384,8 @@ def solver_outcomes(path):
             "no progress in 4 Newton iterations))"): "branch switch after a stall",
         (1, "target reached by arc-length continuation (before: Newton budget of 200 iterations spent)"):
             "arc-length rescue",
+        (1, "target reached from rest without the first-increment hint (first try: Newton budget of 200 "
+            "iterations spent)"): "retry from rest",
         (1, "target reached by load control (displacement control: ...)"): "other",
         (0, "target reached"): "failed",
     }
@@ -393,7 +395,7 @@ def solver_outcomes(path):
                   for f in ("branch_switch.cpp", "path_following.cpp", "nonlinear.cpp"))
     written = ['"target reached after a branch switch ("', '"loss of stability at max|u| = "',
                '"fold: max|u| = target lies on an unstable segment', '"target reached by arc-length continuation',
-               '"target reached"']
+               '"target reached from rest without the first-increment hint', '"target reached"']
     check(all(w in cpp for w in written), "the reasons load_case_outcome reads are the ones src/solver writes")
     out = subprocess.run([sys.executable, script, "solver", path], capture_output=True, text=True).stdout
     check("by outcome (load cases, Newton iterations each): path " in out, "`solver` prints the split by outcome")
