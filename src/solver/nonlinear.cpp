@@ -199,13 +199,22 @@ bool NonlinearSolver::residual_at(Vec X, double s, Vec r) {
   return true;
 }
 
+namespace {
+
+/// Whether a failed path's reason is a verified fold (follow_path: the state on target is on
+/// an unstable segment between limit points of the load), which neither the arc-length rescue
+/// nor a retry from rest gets past.
+bool verified_fold(const std::string& reason) { return reason.rfind("fold:", 0) == 0; }
+
+}  // namespace
+
 TargetResult NonlinearSolver::solve_for_target(double target) {
   const double start = core::now_seconds();
   const LinearCounters linear_before = linear_counters();
   const double hint = step_hint_;
   TargetResult t = attempt_target(target, start);
   if (!t.converged && opt_.retry_from_rest && hint > 0 && opt_.control == Control::displacement && target > 0 &&
-      t.reason.rfind("fold:", 0) != 0) {
+      !verified_fold(t.reason)) {
     // The hint (the previous load case's first increment) set this path's first increment, and
     // with it which branch a bifurcation on the way sent it to. From rest without it, as alone.
     // (Not after a verified fold: the path from rest reaches the same one; measured on the six
@@ -241,14 +250,14 @@ TargetResult NonlinearSolver::attempt_target(double target, double start) {
     switch_branch(target, start, switches, t);
   // A fold verified on the path from rest (follow_path) stays the reason where no switch found
   // a stable state on another branch: the switches' own outcome follows it.
-  if (!t.converged && switches > 0 && first.rfind("fold:", 0) == 0)
+  if (!t.converged && switches > 0 && verified_fold(first))
     t.reason = first + "; " + std::to_string(switches) + " branch switch(es) found no stable state on target (last: " +
                t.reason.substr(0, 400) + ")";
   if (!t.converged && !problem_.conservative() && opt_.branch_switches > 0 && opt_.control == Control::displacement)
     t.reason += "; no branch switch: a follower load has no energy to minimise";
   if (opt_.arc_length_rescue && problem_.space().dim() == 2 && opt_.control == Control::displacement && !t.converged &&
       target > 0 && t.solves > 0 && problem_.conservative() && !problem_.has_fixed_load() &&
-      first.rfind("fold:", 0) != 0) {
+      !verified_fold(first)) {
     const TargetResult before = t;
     t = arc_path(target, start);
     t.add_earlier(before, true);

@@ -110,7 +110,7 @@ struct SolverOptions {
   /// a path whose first increment was the previous load case's (the hint): solve it once more from
   /// rest without the hint, with a budget of its own, as a load case solved alone would be.
   /// The next load case's hint stays the one the first try left, so load cases that converged
-  /// are unchanged bit for bit (docs/SOLVER.md, "A retry from rest").
+  /// are unchanged bit for bit (docs/SOLVER.md, "a retry from rest").
   bool retry_from_rest = true;
   /// The displacement-controlled path's linear solves: Newton-Krylov on a kept factorisation
   /// (default) or a fresh factorisation per Newton iteration (tangent.reuse = false).
