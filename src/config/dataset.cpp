@@ -402,7 +402,9 @@ void parse_mesh(const YamlBlock& top, const std::string& source, DatasetConfig& 
   }
   if (m.has("rim")) {
     const double rim = m.number("rim");
-    if (c.shapes.dim != 3) m.fail("rim", "only for 3D shapes (2D boundaries are graded at the patch ends)");
+    if (c.shapes.dim != 3)
+      m.fail("rim", "only for 3D shapes (2D: the patch ends are vertices of the boundary, its spacing "
+                    "there set by curvature and shapes.h)");
     if (!(rim > 0 && rim <= std::max(c.shapes.h, c.shapes.mesh_h)))
       m.fail("rim", "must be in (0, mesh.h] (edge length at the clamp rim)");
     c.shapes.rim_size = rim;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "hypershape/core/error.hpp"
 #include "hypershape/core/vec_array.hpp"
@@ -54,6 +55,40 @@ double NonlinearSolver::softest_mode() {
   return vkv / vv;
 }
 
+ModeExtent mode_extent(const physics::Problem& problem, Vec v) {
+  DM dm = problem.dm();
+  const int dim = problem.space().dim();
+  const MPI_Comm comm = problem.comm();
+  Vec vl;
+  HS_PETSC(DMGetLocalVector(dm, &vl));
+  HS_PETSC(VecSet(vl, 0.0));
+  HS_PETSC(DMGlobalToLocal(dm, v, INSERT_VALUES, vl));
+  std::vector<double> s2;
+  double best = -1;
+  std::int64_t id = INT64_MAX;
+  std::array<double, 3> at{};
+  {
+    core::VecArray<const PetscScalar> a(vl);
+    for (const auto& n : problem.space().owned_nodes()) {
+      double s = 0;
+      for (int i = 0; i < dim; ++i) s += a[n.offset + i] * a[n.offset + i];
+      s2.push_back(s);
+      if (s > best || (s == best && n.canonical < id)) best = s, id = n.canonical, at = n.x;
+    }
+  }
+  HS_PETSC(DMRestoreLocalVector(dm, &vl));
+  double gbest = best;
+  MPI_Allreduce(MPI_IN_PLACE, &gbest, 1, MPI_DOUBLE, MPI_MAX, comm);
+  std::int64_t gid = best == gbest ? id : INT64_MAX;
+  MPI_Allreduce(MPI_IN_PLACE, &gid, 1, MPI_INT64_T, MPI_MIN, comm);
+  ModeExtent e;
+  if (!(best == gbest && id == gid)) at = {0, 0, 0};  // another rank holds the largest
+  MPI_Allreduce(at.data(), e.at.data(), 3, MPI_DOUBLE, MPI_SUM, comm);
+  for (const double s : s2) e.nodes += s > 0.1 * gbest;
+  MPI_Allreduce(MPI_IN_PLACE, &e.nodes, 1, MPI_LONG, MPI_SUM, comm);
+  return e;
+}
+
 double NonlinearSolver::shift_scale() {
   // A thousandth of K's mean diagonal: the first shift where no negative eigenvalue is estimated.
   HS_PETSC(MatGetDiagonal(tangent_->matrix(), w_));
@@ -80,10 +115,12 @@ bool NonlinearSolver::shift_past_lowest_mode(double mu0, double& mu, double& lam
     if (tangent_->factorise() && tangent_->negative_eigenvalues() == 0) break;
     if (k == 11) return false;
   }
-  if (!negative_found) {
-    const double nearest_zero = lam;
-    lam = softest_mode() - mu;  // the matrix and factor are K + mu I's
-    HS_PETSC(PetscInfo(snes_.get(), "lowest mode: %g (the mode nearest zero: %g), shift %g\n", lam, nearest_zero, mu));
+  const double nearest_zero = lam;
+  if (!negative_found) lam = softest_mode() - mu;  // the matrix and factor are K + mu I's
+  if (PetscLogPrintInfo) {  // where it lives (an element-scale crease or the body's buckling)
+    const ModeExtent e = mode_extent(problem_, v_);
+    HS_PETSC(PetscInfo(snes_.get(), "lowest mode: %g (the mode nearest zero: %g), shift %g; on %ld node(s) around (%g, %g, %g)\n",
+                       lam, nearest_zero, mu, e.nodes, e.at[0], e.at[1], e.at[2]));
   }
   return true;
 }

@@ -427,3 +427,41 @@ TEST_CASE("The blocked LDL^T (2x2 nodes, AMD ordering) solves as MUMPS does and 
     }
   }
 }
+
+TEST_CASE("mode_extent: how many nodes a mode lives on, and where its largest entry is", "[solver]") {
+  DiskScene d;
+  const physics::Problem& p = d.problem;
+  core::VecH v = p.create_vector();
+  PetscInt n;
+  HS_PETSC(VecGetSize(v, &n));
+  // Everywhere alike: every free node (the clamped ones carry no unknowns).
+  HS_PETSC(VecSet(v, 1.0));
+  CHECK(solver::mode_extent(p, v).nodes == n / 2);
+  // One node (its two unknowns, global 0 and 1), and a neighbour-free tail far below a tenth.
+  HS_PETSC(VecSet(v, 1e-3));
+  PetscInt lo, hi;
+  HS_PETSC(VecGetOwnershipRange(v, &lo, &hi));
+  if (lo == 0) {
+    HS_PETSC(VecSetValue(v, 0, -2.0, INSERT_VALUES));
+    HS_PETSC(VecSetValue(v, 1, 1.0, INSERT_VALUES));
+  }
+  HS_PETSC(VecAssemblyBegin(v));
+  HS_PETSC(VecAssemblyEnd(v));
+  const solver::ModeExtent e = solver::mode_extent(p, v);
+  CHECK(e.nodes == 1);
+  // `at` is that node: a mesh node at distance 0, inside the unit disk.
+  const auto& xs = p.space().canonical_coords();
+  double nearest = INFINITY;
+  for (std::size_t i = 0; i + 1 < xs.size(); i += 2) nearest = std::min(nearest, std::hypot(xs[i] - e.at[0], xs[i + 1] - e.at[1]));
+  CHECK(nearest == 0.0);
+  CHECK(std::hypot(e.at[0], e.at[1]) <= 1.0 + 1e-12);
+  // A larger entry elsewhere moves `at` there: the first node is no longer the largest.
+  HS_PETSC(VecSet(v, 0.0));
+  if (hi == n) HS_PETSC(VecSetValue(v, n - 1, 5.0, INSERT_VALUES));
+  if (lo == 0) HS_PETSC(VecSetValue(v, 0, 1.0, INSERT_VALUES));
+  HS_PETSC(VecAssemblyBegin(v));
+  HS_PETSC(VecAssemblyEnd(v));
+  const solver::ModeExtent f = solver::mode_extent(p, v);
+  CHECK(f.nodes == 1);
+  CHECK(std::hypot(f.at[0] - e.at[0], f.at[1] - e.at[1]) > 0.0);
+}

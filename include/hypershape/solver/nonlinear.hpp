@@ -63,6 +63,7 @@
 
 #include <memory>
 #include <optional>
+#include <array>
 #include <string>
 #include <utility>
 #include <vector>
@@ -166,6 +167,17 @@ struct TargetResult {
 /// Puts config-file PETSc options (name with dash, value or "") into the options database,
 /// except those already given (on the command line, which wins). Not collective.
 void set_default_options(const std::vector<std::pair<std::string, std::string>>& options);
+
+/// Where a displacement-like vector v of `problem` (a mode of the tangent) lives: `nodes`, the
+/// nodes whose |v_i|^2 exceeds a tenth of the largest, and `at`, the reference coordinates of the
+/// largest (ties: the smallest canonical node id), the same on any rank count. A handful of
+/// nodes is a local instability (an element-scale crease), hundreds or more a global one (the
+/// body buckling). Collective.
+struct ModeExtent {
+  long nodes = 0;
+  std::array<double, 3> at{};
+};
+ModeExtent mode_extent(const physics::Problem& problem, Vec v);
 
 class NonlinearSolver {
  public:
