@@ -11,6 +11,7 @@
 
 #include "hypershape/core/error.hpp"
 #include "hypershape/core/vec_array.hpp"
+#include "largest_node.hpp"
 #include "log_events.hpp"
 
 namespace hypershape::solver {
@@ -57,35 +58,23 @@ double NonlinearSolver::softest_mode() {
 
 ModeExtent mode_extent(const physics::Problem& problem, Vec v) {
   DM dm = problem.dm();
-  const int dim = problem.space().dim();
-  const MPI_Comm comm = problem.comm();
   Vec vl;
   HS_PETSC(DMGetLocalVector(dm, &vl));
   HS_PETSC(VecSet(vl, 0.0));
   HS_PETSC(DMGlobalToLocal(dm, v, INSERT_VALUES, vl));
   std::vector<double> s2;
-  double best = -1;
-  std::int64_t id = INT64_MAX;
-  std::array<double, 3> at{};
+  LargestNode top;
   {
     core::VecArray<const PetscScalar> a(vl);
-    for (const auto& n : problem.space().owned_nodes()) {
-      double s = 0;
-      for (int i = 0; i < dim; ++i) s += a[n.offset + i] * a[n.offset + i];
-      s2.push_back(s);
-      if (s > best || (s == best && n.canonical < id)) best = s, id = n.canonical, at = n.x;
-    }
+    top = largest_node(problem.space(), a.data(), problem.comm(), &s2);
   }
   HS_PETSC(DMRestoreLocalVector(dm, &vl));
-  double gbest = best;
-  MPI_Allreduce(MPI_IN_PLACE, &gbest, 1, MPI_DOUBLE, MPI_MAX, comm);
-  std::int64_t gid = best == gbest ? id : INT64_MAX;
-  MPI_Allreduce(MPI_IN_PLACE, &gid, 1, MPI_INT64_T, MPI_MIN, comm);
   ModeExtent e;
-  if (!(best == gbest && id == gid)) at = {0, 0, 0};  // another rank holds the largest
-  MPI_Allreduce(at.data(), e.at.data(), 3, MPI_DOUBLE, MPI_SUM, comm);
-  for (const double s : s2) e.nodes += s > 0.1 * gbest;
-  MPI_Allreduce(MPI_IN_PLACE, &e.nodes, 1, MPI_LONG, MPI_SUM, comm);
+  std::array<double, 3> at{};  // summed over ranks: only the owner's is not zero
+  if (top.here) at = top.here->x;
+  MPI_Allreduce(at.data(), e.at.data(), 3, MPI_DOUBLE, MPI_SUM, problem.comm());
+  for (const double s : s2) e.nodes += s > 0.1 * top.norm2;
+  MPI_Allreduce(MPI_IN_PLACE, &e.nodes, 1, MPI_LONG, MPI_SUM, problem.comm());
   return e;
 }
 

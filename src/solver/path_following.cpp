@@ -14,6 +14,7 @@
 #include "hypershape/core/timer.hpp"
 #include "hypershape/core/vec_array.hpp"
 #include "hypershape/solver/step_control.hpp"
+#include "largest_node.hpp"
 #include "log_events.hpp"
 
 namespace hypershape::solver {
@@ -95,36 +96,20 @@ const std::vector<PetscInt>& NonlinearSolver::global_of_local() {
 double NonlinearSolver::control_direction(Vec u, Vec fallback, Vec c) {
   DM dm = problem_.dm();
   const int dim = problem_.space().dim();
-  const MPI_Comm comm = problem_.comm();
   Vec ul;
   HS_PETSC(DMGetLocalVector(dm, &ul));
-  std::int64_t node = -1;
   // The node of the largest |v| (ties: the smallest canonical index, on any rank count).
-  auto largest = [&](Vec v, PetscInt& offset, double& norm2) {
+  auto largest = [&](Vec v) {
     HS_PETSC(VecSet(ul, 0.0));
     HS_PETSC(DMGlobalToLocal(dm, v, INSERT_VALUES, ul));
     core::VecArray<const PetscScalar> a(ul);
-    double best = -1;
-    std::int64_t id = INT64_MAX;
-    offset = -1;
-    for (const auto& n : problem_.space().owned_nodes()) {
-      double s = 0;
-      for (int i = 0; i < dim; ++i) s += a[n.offset + i] * a[n.offset + i];
-      if (s > best || (s == best && n.canonical < id)) best = s, id = n.canonical, offset = n.offset;
-    }
-    double gbest = best;
-    MPI_Allreduce(MPI_IN_PLACE, &gbest, 1, MPI_DOUBLE, MPI_MAX, comm);
-    std::int64_t gid = best == gbest ? id : INT64_MAX;
-    MPI_Allreduce(MPI_IN_PLACE, &gid, 1, MPI_INT64_T, MPI_MIN, comm);
-    if (!(best == gbest && id == gid)) offset = -1;  // another rank owns the node
-    norm2 = gbest;
-    node = gid;
+    return largest_node(problem_.space(), a.data(), problem_.comm());
   };
-  PetscInt off;
-  double m2;
-  largest(u, off, m2);
-  if (m2 <= 0.0) largest(fallback, off, m2);  // u = 0: the node that will move most
-  const double m = std::sqrt(std::max(m2, 0.0));
+  LargestNode top = largest(u);
+  if (top.norm2 <= 0.0) top = largest(fallback);  // u = 0: the node that will move most
+  const std::int64_t node = top.canonical;
+  const PetscInt off = top.here ? top.here->offset : -1;
+  const double m = std::sqrt(std::max(top.norm2, 0.0));
   const std::vector<PetscInt>& global = global_of_local();  // collective at its first call
   HS_PETSC(VecSet(c, 0.0));
   if (off >= 0 && m > 0) {  // ul still holds the vector the node was picked from (owned here)

@@ -139,3 +139,38 @@ TEST_CASE("The disk scene has the same solution on any number of ranks", "[mpi]"
     }
   }
 }
+
+TEST_CASE("Where a mode lives is the same on any number of ranks", "[mpi]") {
+  // A bump around (-0.1, 0.1), wide enough (its tenth at r = 0.64) to lie on every rank's part
+  // of the disk: the count is summed over ranks, the peak is one node.
+  auto bump = [](const double* x, double* v) {
+    const double r2 = (x[0] + 0.1) * (x[0] + 0.1) + (x[1] - 0.1) * (x[1] - 0.1);
+    v[0] = std::exp(-r2 / (2 * 0.3 * 0.3));
+    v[1] = 0.5 * v[0];
+  };
+  for (int degree : {1, 2}) {
+    DYNAMIC_SECTION("P" << degree) {
+      solver::ModeExtent ref;
+      if (world_rank() == 0) {
+        physics::Problem p(PETSC_COMM_SELF, hstest::disk_mesh(h), hstest::disk_effects(), hstest::degree(degree));
+        core::VecH v = p.create_vector();
+        hstest::interpolate(p, bump, v);
+        ref = solver::mode_extent(p, v);
+      }
+      mesh::MeshData m;
+      if (world_rank() == 0) m = hstest::disk_mesh(h);
+      physics::Problem p(PETSC_COMM_WORLD, m, hstest::disk_effects(), hstest::degree(degree));
+      core::VecH v = p.create_vector();
+      hstest::interpolate(p, bump, v);
+      const solver::ModeExtent par = solver::mode_extent(p, v);
+      const double same = broadcast(world_rank() == 0 ? double(par.nodes == ref.nodes && par.at == ref.at) : 0.0);
+      const double nodes = broadcast(world_rank() == 0 ? double(ref.nodes) : 0.0);
+      const double dist = broadcast(world_rank() == 0 ? std::hypot(ref.at[0] + 0.1, ref.at[1] - 0.1) : 0.0);
+      INFO("ranks " << core::size(PETSC_COMM_WORLD) << ": " << par.nodes << " nodes at (" << par.at[0] << ", "
+                    << par.at[1] << ")");
+      CHECK(same == 1.0);
+      CHECK(nodes > 10);   // a patch, not one node
+      CHECK(dist < h);     // the peak is the node next to the bump's centre
+    }
+  }
+}

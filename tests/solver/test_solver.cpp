@@ -437,7 +437,7 @@ TEST_CASE("mode_extent: how many nodes a mode lives on, and where its largest en
   // Everywhere alike: every free node (the clamped ones carry no unknowns).
   HS_PETSC(VecSet(v, 1.0));
   CHECK(solver::mode_extent(p, v).nodes == n / 2);
-  // One node (its two unknowns, global 0 and 1), and a neighbour-free tail far below a tenth.
+  // One node (its two unknowns, global 0 and 1) above a small floor everywhere else.
   HS_PETSC(VecSet(v, 1e-3));
   PetscInt lo, hi;
   HS_PETSC(VecGetOwnershipRange(v, &lo, &hi));

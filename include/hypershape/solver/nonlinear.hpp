@@ -61,9 +61,9 @@
 /// failed path (fallback: true; it rescued none of the failures there at twice their cost).
 #include <petscsnes.h>
 
+#include <array>
 #include <memory>
 #include <optional>
-#include <array>
 #include <string>
 #include <utility>
 #include <vector>
