@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "hypershape/config/dataset.hpp"
+#include "hypershape/factory/accuracy.hpp"
 #include "hypershape/factory/dataset_scene.hpp"
 #include "hypershape/factory/load_cases.hpp"
 #include "hypershape/factory/shape_pipeline.hpp"
@@ -40,7 +41,10 @@ struct Case {
   std::vector<factory::LoadCase> loads;
   factory::ShapeProblem sp;
 
-  Case(std::uint64_t seed, int shape_id, const std::string& config = HS_SOURCE_DIR "/configs/presets/random2d.yaml")
+  /// `refine` > 0: the shape's mesh refined uniformly that many times after the draws (polygon,
+  /// p_D and loads unchanged: factory::refine_shape); `degree` > 0: that element degree.
+  Case(std::uint64_t seed, int shape_id, const std::string& config = HS_SOURCE_DIR "/configs/presets/random2d.yaml",
+       int refine = 0, int degree = 0)
       : cfg(config::parse_dataset_file(config)) {
     // The targets are stratified over the load count: 50 as scripts/bench_stability.sh runs the
     // preset, or LOADS (a dataset config's own count, to replay its load cases).
@@ -48,6 +52,8 @@ struct Case {
     cfg.seed = seed;
     shape = factory::make_shape(factory::shape_config(cfg, shape_id), std::nullopt, cfg.seed, shape_id);
     loads = factory::draw_load_cases(shape, cfg.loads, cfg.seed, factory::n_tractions(cfg));
+    for (int k = 0; k < refine; ++k) shape = factory::refine_shape(shape);
+    if (degree > 0) cfg.degree = degree;
     sp = factory::make_shape_problem(PETSC_COMM_WORLD, cfg, shape, loads[0]);
   }
   const factory::LoadCase& set(int load_id) {
@@ -97,10 +103,21 @@ TEST_CASE("Unseen-seed load cases that need a branch switch end stable on target
 ///   SEED=777 SHAPE=3 LOAD=47 PETSC_OPTIONS="-info :snes" unit_tests "[unseen_replay]"
 ///   CONFIG=configs/examples/multi_load2d.yaml SEED=17 SHAPE=19 LOAD=3 unit_tests "[unseen_replay]"
 ///   CONFIG=random3d_10x20.yaml LOADS=20 SEED=90210 SHAPE=0 LOAD=0 unit_tests "[unseen_replay]"
+/// REFINE=k solves on the shape's mesh refined uniformly k times (the same polygon, p_D and loads),
+/// DEG=1|2 with that element degree: whether a load case fails at every resolution
+/// (docs/STABILITY.md, "Which discretisation loses these load cases"):
+///   CONFIG=p2-8888.yaml SEED=8888 SHAPE=9 LOAD=2 FROM=2 REFINE=2 DEG=1 unit_tests "[unseen_replay]"
+/// (p2-8888.yaml: {preset: random2d, seed: 8888, shapes: {count: 20, h: 0.12}, mesh: {degree: 2},
+/// loads: {count: 50}}).
 TEST_CASE("Replay one shape's load cases as the factory does", "[.][unseen_replay]") {
   const char* config = std::getenv("CONFIG");
   Case c(std::uint64_t(env_int("SEED", 777)), env_int("SHAPE", 3),
-         config ? config : HS_SOURCE_DIR "/configs/presets/random2d.yaml");
+         config ? config : HS_SOURCE_DIR "/configs/presets/random2d.yaml", env_int("REFINE", 0), env_int("DEG", 0));
+  const auto& lc = c.loads[std::size_t(env_int("LOAD", 47))];
+  std::cout << "shape draw " << c.shape.attempt << ", p_D (" << c.shape.dirichlet_center[0] << ", "
+            << c.shape.dirichlet_center[1] << "), " << c.shape.mesh.n_vertices() << " mesh vertices, P" << c.cfg.degree
+            << "; load p_N (" << lc.center[0] << ", " << lc.center[1] << "), g (" << lc.direction[0] << ", "
+            << lc.direction[1] << ")\n";
   solver::NonlinearSolver ns(*c.sp.problem, c.cfg.solver);
   replay(c, ns, env_int("FROM", 0), env_int("LOAD", 47));
 }
