@@ -111,15 +111,21 @@ TEST_CASE("Unseen-seed load cases that need a branch switch end stable on target
 /// loads: {count: 50}}).
 TEST_CASE("Replay one shape's load cases as the factory does", "[.][unseen_replay]") {
   const char* config = std::getenv("CONFIG");
+  const int refine = env_int("REFINE", 0), degree = env_int("DEG", 0), load = env_int("LOAD", 47);
+  REQUIRE(refine >= 0);
+  REQUIRE((degree == 0 || degree == 1 || degree == 2));  // 0: the config's own
   Case c(std::uint64_t(env_int("SEED", 777)), env_int("SHAPE", 3),
-         config ? config : HS_SOURCE_DIR "/configs/presets/random2d.yaml", env_int("REFINE", 0), env_int("DEG", 0));
-  const auto& lc = c.loads[std::size_t(env_int("LOAD", 47))];
+         config ? config : HS_SOURCE_DIR "/configs/presets/random2d.yaml", refine, degree);
+  REQUIRE(load >= 0);
+  REQUIRE(std::size_t(load) < c.loads.size());  // LOADS: the config's load count, if not 50
+  REQUIRE(env_int("FROM", 0) >= 0);
+  const auto& lc = c.loads[std::size_t(load)];
   std::cout << "shape draw " << c.shape.attempt << ", p_D (" << c.shape.dirichlet_center[0] << ", "
             << c.shape.dirichlet_center[1] << "), " << c.shape.mesh.n_vertices() << " mesh vertices, P" << c.cfg.degree
             << "; load p_N (" << lc.center[0] << ", " << lc.center[1] << "), g (" << lc.direction[0] << ", "
             << lc.direction[1] << ")\n";
   solver::NonlinearSolver ns(*c.sp.problem, c.cfg.solver);
-  replay(c, ns, env_int("FROM", 0), env_int("LOAD", 47));
+  replay(c, ns, env_int("FROM", 0), load);
 }
 
 TEST_CASE("A load case lost on the hinted path is solved again from rest; the next one is unchanged",
