@@ -6,7 +6,7 @@
 /// the scene on the uniformly refined meshes h/2 and h/4 (3D: h/2), Richardson-extrapolated
 /// with the observed order (study::run_estimate_study). One JSON line per load case.
 /// Sample runs (one rank; scripts/error_estimate_study.sh runs the table of docs/ACCURACY.md):
-///   study_error_estimate --preset random2d --shapes 0 1 --loads 2 -- -ref_pc_factor_mat_solver_type mumps
+///   study_error_estimate --preset random2d_p1 --shapes 0 1 --loads 2 -- -ref_pc_factor_mat_solver_type mumps
 ///   study_error_estimate --scene disk --degree 2 --h 0.08
 #include <CLI/CLI.hpp>
 #include <fstream>

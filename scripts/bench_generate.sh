@@ -9,6 +9,7 @@
 #   PRESET=random3d scripts/bench_generate.sh 10 20 1       (a Random3D slice of 200 load cases)
 #   SEED=90210 ...                                          (another seed than the preset's)
 #   SHAPES_H=0.12 MESH='{degree: 2}' ...                    (another discretisation: shapes.h, mesh:)
+#   PRESET=random2d_p1 ...                                  (Random2D at P1 h 0.04, the preset until 2026-11-28)
 # Two projections of the full preset: from the slice's rate (its wall time; a small slice ends
 # with one rank idle while the other finishes the last shard), and from its work (phase seconds
 # summed over ranks, spread evenly over the ranks, plus one shard of the full run's size run

@@ -17,26 +17,26 @@ parts=("$@")
 [ ${#parts[@]} -gt 0 ] || parts=(random2d scenes2d p2 random2d_p2 easy_random2d_p2 random3d scenes3d report)
 for part in "${parts[@]}"; do
   case $part in
-    random2d)  # 17 Random2D shapes x 3 load cases, as the preset generates them (P1, h 0.04)
-      "$BIN" --preset random2d --shapes $(seq 0 16) --loads 3 --out "$OUT/random2d.jsonl" -- "${ref[@]}" ;;
+    random2d)  # 17 Random2D shapes x 3 load cases at P1 h 0.04 (the random2d_p1 preset, random2d before 2026-11-28)
+      "$BIN" --preset random2d_p1 --shapes $(seq 0 16) --loads 3 --out "$OUT/random2d.jsonl" -- "${ref[@]}" ;;
     scenes2d)  # the accuracy study's 2D scenes at their presets' settings, targets 0.1 0.3 0.5
       for s in disk r2d-0 r2d-1 ood-0 easy-0; do "$BIN" --scene $s --out "$OUT/scenes2d.jsonl" -- "${ref[@]}"; done ;;
     p2)        # P2 on the same scenes at h 0.08 (references P2 at h 0.04 and 0.02)
       for s in disk r2d-0 r2d-1 ood-0; do "$BIN" --scene $s --degree 2 --h 0.08 --out "$OUT/p2.jsonl" -- "${ref[@]}"; done ;;
     random2d_p2)  # Random2D shapes no other run used (20-27), P2 at h 0.08, 2 load cases each
-      "$BIN" --preset random2d --degree 2 --h 0.08 --shapes $(seq 20 27) --loads 2 --out "$OUT/random2d_p2.jsonl" -- "${ref[@]}" ;;
+      "$BIN" --preset random2d_p1 --degree 2 --h 0.08 --shapes $(seq 20 27) --loads 2 --out "$OUT/random2d_p2.jsonl" -- "${ref[@]}" ;;
     easy_random2d_p2)  # EasyRandom2D at its preset's P2 h 0.12, the same unused shapes
       "$BIN" --preset easy_random2d --shapes $(seq 20 27) --loads 2 --out "$OUT/easy_random2d_p2.jsonl" -- "${ref[@]}" ;;
     graded)    # the same on meshes graded towards the clamp ends (h/8, h/32 there), and the estimate
                # with Newton to tolerance on the fine mesh (estimate only: joined with the truths above)
       mkdir -p "$OUT/graded"
-      "$BIN" --preset random2d --degree 2 --h 0.08 --graded 0.125 --shapes $(seq 20 27) --loads 2 \
+      "$BIN" --preset random2d_p1 --degree 2 --h 0.08 --graded 0.125 --shapes $(seq 20 27) --loads 2 \
         --out "$OUT/graded/random2d_p2_graded0.125.jsonl" -- "${ref[@]}"
-      "$BIN" --preset random2d --degree 2 --h 0.08 --graded 0.03125 --shapes 20 21 22 23 --loads 2 \
+      "$BIN" --preset random2d_p1 --degree 2 --h 0.08 --graded 0.03125 --shapes 20 21 22 23 --loads 2 \
         --out "$OUT/graded/random2d_p2_graded0.03125.jsonl" -- "${ref[@]}"
-      "$BIN" --preset random2d --degree 2 --h 0.08 --shapes $(seq 20 27) --loads 2 --fine-newton --estimate-only \
+      "$BIN" --preset random2d_p1 --degree 2 --h 0.08 --shapes $(seq 20 27) --loads 2 --fine-newton --estimate-only \
         --out "$OUT/graded/random2d_p2_fine_newton_estimate_only.jsonl"
-      "$BIN" --preset random2d --degree 2 --h 0.08 --graded 0.125 --shapes $(seq 20 27) --loads 2 --fine-newton \
+      "$BIN" --preset random2d_p1 --degree 2 --h 0.08 --graded 0.125 --shapes $(seq 20 27) --loads 2 --fine-newton \
         --estimate-only --out "$OUT/graded/random2d_p2_graded0.125_fine_newton_estimate_only.jsonl" ;;
     random3d)  # Random3D shapes (P2) as the preset solves them, coarser (mesh.h 0.5) so that a
                # reference two refinements finer stays within reach of one core

@@ -510,7 +510,7 @@ const char* default_dataset_text() {
   return R"(# The embedded default dataset: a small slice of Random2D (seed paper, Table 1).
 preset: random2d
 name: default
-shapes: {count: 4, h: 0.06}
+shapes: {count: 4}
 loads: {count: 6}
 representations: {grid_size: 64}
 output: {shard_size: 2}

@@ -25,9 +25,9 @@ void apply_defaults(AccuracyOptions& a) {
 }
 
 const std::vector<SceneSpec>& accuracy::study_scenes() {
-  static const std::vector<SceneSpec> all{{"disk", "random2d", SceneKind::disk, 0},
-                                          {"r2d-0", "random2d", SceneKind::random2d, 0},
-                                          {"r2d-1", "random2d", SceneKind::random2d, 1},
+  static const std::vector<SceneSpec> all{{"disk", "random2d_p1", SceneKind::disk, 0},
+                                          {"r2d-0", "random2d_p1", SceneKind::random2d, 0},
+                                          {"r2d-1", "random2d_p1", SceneKind::random2d, 1},
                                           {"ood-0", "ood_random2d", SceneKind::random2d, 0},
                                           {"easy-0", "easy_random2d", SceneKind::random2d, 0},
                                           {"ball", "random3d", SceneKind::ball, 0},
@@ -38,7 +38,7 @@ const std::vector<SceneSpec>& accuracy::study_scenes() {
 namespace {
 
 std::vector<SceneSpec> scene_specs(const AccuracyOptions& a) {
-  if (a.tiny) return {{"disk", "random2d", SceneKind::disk, 0}};
+  if (a.tiny) return {{"disk", "random2d_p1", SceneKind::disk, 0}};
   std::vector<SceneSpec> specs;
   for (const auto& s : study_scenes()) {
     const int dim = s.preset == "random3d" ? 3 : 2;

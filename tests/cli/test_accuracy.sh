@@ -7,7 +7,7 @@
 # Needs HYPERSHAPE_BIN and HYPERSHAPE_SOURCE_DIR (set by CTest).
 . "$(dirname "$0")/lib.sh"
 
-base='preset: random2d
+base='preset: random2d_p1
 name: acc
 seed: 7
 shapes: {count: 2, h: 0.1}

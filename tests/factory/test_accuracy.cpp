@@ -20,7 +20,7 @@ using namespace hypershape;
 
 namespace {
 
-const std::string head = "preset: random2d\nseed: 5\nshapes: {count: 3, h: 0.08}\nloads: {count: 2}\n";
+const std::string head = "preset: random2d_p1\nseed: 5\nshapes: {count: 3, h: 0.08}\nloads: {count: 2}\n";
 
 std::string message(const std::string& text) {
   try {

@@ -34,7 +34,7 @@ from checks import check  # noqa: E402
 
 CONFIGS = {
     # 4 shapes: 2 / 1 / 1 in train / val / test
-    "t2d": """preset: random2d
+    "t2d": """preset: random2d_p1
 name: t2d
 seed: 7
 shapes: {count: 4, h: 0.1}
@@ -53,7 +53,7 @@ output: {shard_size: 1}
 """,
     # one redraw allowed and a strict neck test: some shapes fail; one load increment and few
     # Newton steps: most load cases fail
-    "failing": """preset: random2d
+    "failing": """preset: random2d_p1
 name: failing
 seed: 7
 shapes: {count: 3, h: 0.1, max_attempts: 1, min_feature_fraction: 0.08}

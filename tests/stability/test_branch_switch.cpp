@@ -22,7 +22,7 @@
 using namespace hypershape;
 
 TEST_CASE("Branch switching turns lost stability into stable equilibria on target", "[stability][branch]") {
-  auto cfg = config::parse_dataset_file(std::string(HS_SOURCE_DIR) + "/configs/presets/random2d.yaml");
+  auto cfg = config::parse_dataset_file(std::string(HS_SOURCE_DIR) + "/configs/presets/random2d_p1.yaml");
   cfg.loads.count = 50;  // the targets are stratified over the load count: keep the preset's
   const std::vector<std::pair<int, int>> cases = {{0, 27}, {6, 24}, {11, 36}, {14, 47}};
   int lost_without = 0;

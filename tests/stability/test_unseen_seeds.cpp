@@ -43,7 +43,7 @@ struct Case {
 
   /// `refine` > 0: the shape's mesh refined uniformly that many times after the draws (polygon,
   /// p_D and loads unchanged: factory::refine_shape); `degree` > 0: that element degree.
-  Case(std::uint64_t seed, int shape_id, const std::string& config = HS_SOURCE_DIR "/configs/presets/random2d.yaml",
+  Case(std::uint64_t seed, int shape_id, const std::string& config = HS_SOURCE_DIR "/configs/presets/random2d_p1.yaml",
        int refine = 0, int degree = 0)
       : cfg(config::parse_dataset_file(config)) {
     // The targets are stratified over the load count: 50 as scripts/bench_stability.sh runs the
@@ -115,7 +115,7 @@ TEST_CASE("Replay one shape's load cases as the factory does", "[.][unseen_repla
   REQUIRE(refine >= 0);
   REQUIRE((degree == 0 || degree == 1 || degree == 2));  // 0: the config's own
   Case c(std::uint64_t(env_int("SEED", 777)), env_int("SHAPE", 3),
-         config ? config : HS_SOURCE_DIR "/configs/presets/random2d.yaml", refine, degree);
+         config ? config : HS_SOURCE_DIR "/configs/presets/random2d_p1.yaml", refine, degree);
   REQUIRE(load >= 0);
   REQUIRE(std::size_t(load) < c.loads.size());  // LOADS: the config's load count, if not 50
   REQUIRE(env_int("FROM", 0) >= 0);
@@ -260,7 +260,7 @@ TEST_CASE("Under fixed gravity the path starts from the gravity state and keeps 
 ///   CONFIG=r3d.yaml LOADS=8 SEED=90210 SHAPE=0 unit_tests "[inversion_replay]"
 TEST_CASE("Replay a shape's load cases: min det F between the quadrature points", "[.][inversion_replay]") {
   const char* config = std::getenv("CONFIG");
-  Case c(std::uint64_t(env_int("SEED", 777)), env_int("SHAPE", 3), config ? config : HS_SOURCE_DIR "/configs/presets/random2d.yaml");
+  Case c(std::uint64_t(env_int("SEED", 777)), env_int("SHAPE", 3), config ? config : HS_SOURCE_DIR "/configs/presets/random2d_p1.yaml");
   solver::NonlinearSolver ns(*c.sp.problem, c.cfg.solver);
   const mesh::RefinedMesh refined = mesh::refine_uniform(c.shape.mesh);
   factory::ShapeSample fs;
