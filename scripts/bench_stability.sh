@@ -7,6 +7,8 @@
 #   scripts/bench_stability.sh [SHAPES_2D] [SHAPES_3D]   (default 20 x 50 = 1000 load cases per
 #   seed in 2D, 10 x 20 = 200 in 3D; JSON: results/bench_stability.json)
 #   SEEDS="777 2024 31337" SEEDS3D="4242" scripts/bench_stability.sh   (defaults: the presets' own)
+#   PRESET2D=random2d_p1 (the 2D preset, default random2d: P2 h 0.12 since 2026-11-28; random2d_p1
+#   is the former P1 h 0.04, which the 2D rows measured before that day used)
 #   NP=2 (ranks, default 2); HYPERSHAPE=path/to/binary (default build/hypershape: a copy keeps a long
 #   run on the build it started with); KEEP=dir keeps the datasets there (else a temporary dir);
 #   JSON=file (default results/bench_stability.json); a second argument of 0 (e.g. `scripts/bench_stability.sh 20 0`) skips 3D,
@@ -54,8 +56,8 @@ run_config() {  # $1 a dataset config: its counts replaced, its name by the tag
 }
 for c in ${CONFIGS:-}; do run_config "$c"; done
 if [ "$shapes2" -gt 0 ]; then
-  for s in ${SEEDS:-}; do run random2d "$shapes2" 50 "$s"; done
-  [ -z "${SEEDS:-}${CONFIGS:-}" ] && run random2d "$shapes2" 50 ""
+  for s in ${SEEDS:-}; do run "${PRESET2D:-random2d}" "$shapes2" 50 "$s"; done
+  [ -z "${SEEDS:-}${CONFIGS:-}" ] && run "${PRESET2D:-random2d}" "$shapes2" 50 ""
 fi
 if [ "$shapes3" -gt 0 ]; then
   for s in ${SEEDS3D:-}; do run random3d "$shapes3" 20 "$s"; done

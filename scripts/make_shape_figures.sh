@@ -16,7 +16,7 @@
 #   HYPERSHAPE_BIN   the CLI (default build/hypershape)
 #   NP               MPI ranks (default 2; 1 runs without mpiexec)
 #   N2D, N3D         shapes per 2D / 3D preset (default 200 / 30; at least 16 for the gallery)
-#   PRESETS          preset names (default: all six)
+#   PRESETS          preset names (default: all seven)
 #   PRESET_TIMEOUT   seconds per preset, 0 = none (default 900); a preset that runs out is
 #                    reported and skipped (a killed run writes no file). 30 Random3D shapes take
 #                    about 3.5 min on one core (AugLiver 40 s); a 3D shape whose every draw fails
@@ -31,7 +31,7 @@ BIN="${HYPERSHAPE_BIN:-build/hypershape}"
 NP="${NP:-2}"
 N2D="${N2D:-200}"
 N3D="${N3D:-30}"
-PRESETS="${PRESETS:-random2d easy_random2d ood_random2d one_random2d random3d aug_liver}"
+PRESETS="${PRESETS:-random2d random2d_p1 easy_random2d ood_random2d one_random2d random3d aug_liver}"
 PRESET_TIMEOUT="${PRESET_TIMEOUT:-900}"
 SHAPES_DIR="${SHAPES_DIR:-results/shapes}"
 OUT_DIR="${OUT_DIR:-docs/figures}"

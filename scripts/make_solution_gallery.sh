@@ -14,7 +14,7 @@
 #
 # Environment:
 #   HYPERSHAPE_BIN  the CLI (default build/hypershape)
-#   PRESETS         preset names (default: all eight; PRESETS= for none)
+#   PRESETS         preset names (default: all nine; PRESETS= for none)
 #   CONFIGS         example dataset configs drawn as they are (default: configs/examples/*.yaml;
 #                   CONFIGS= for none)
 #   DATA_DIR        where the mini datasets go (default results/gallery; rewritten)
@@ -23,7 +23,7 @@ set -euo pipefail
 
 cd "$(dirname "$0")/.."
 : "${HYPERSHAPE_BIN:=build/hypershape}" "${DATA_DIR:=results/gallery}" "${OUT_DIR:=docs/figures}"
-: "${PRESETS=random2d easy_random2d ood_random2d one_random2d random3d aug_liver liver one_liver}"
+: "${PRESETS=random2d random2d_p1 easy_random2d ood_random2d one_random2d random3d aug_liver liver one_liver}"
 : "${CONFIGS=$(ls configs/examples/*.yaml)}"
 BIN=$HYPERSHAPE_BIN
 export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1

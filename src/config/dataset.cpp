@@ -378,6 +378,15 @@ void parse_mesh(const YamlBlock& top, const std::string& source, DatasetConfig& 
     if (d != 1 && d != 2) m.fail("degree", "must be 1 or 2");
     c.degree = int(d);
   }
+  if (m.has("quadrature")) {
+    const long q = m.integer("quadrature");
+    const int lowest = c.degree == 1 ? 1 : 2;
+    if (q < lowest || q > 8)
+      m.fail("quadrature", fmt::format("must be an integer in [{}, 8]: the polynomial degree the cell rule "
+                                       "integrates exactly (default 2 x degree - 1; below 2, P2 has "
+                                       "zero-energy modes)", lowest));
+    c.quadrature = int(q);
+  }
   if (m.has("h")) {
     const double mh = m.number("h");
     if (c.shapes.dim != 3)
@@ -409,7 +418,7 @@ void parse_mesh(const YamlBlock& top, const std::string& source, DatasetConfig& 
       m.fail("rim", "must be in (0, mesh.h] (edge length at the clamp rim)");
     c.shapes.rim_size = rim;
   }
-  m.allowed("degree, h (3D: mesh edge length when coarser than shapes.h), surface_h (3D: surface edge "
+  m.allowed("degree, quadrature (exactness of the cell rule), h (3D: mesh edge length when coarser than shapes.h), surface_h (3D: surface edge "
             "length, shapes.h keeps it as drawn), rim (3D: edge length at the clamp rim)");
   m.check_all_used();
 }
@@ -458,6 +467,8 @@ void parse_accuracy(const YamlBlock& top, const std::string& source, DatasetConf
     throw InputError(source, "representations.error_estimate",
                      "accuracy: needs the error estimate (it is the indicator): leave error_estimate out or true");
   c.representations.error_estimate = true;
+  if (acc.max_level > 0 && c.quadrature == 1)
+    throw InputError(source, "mesh.quadrature", "1 with accuracy: the ladder goes on to P2, which needs at least 2");
 }
 
 void parse_split(const YamlBlock& top, const std::string& source, DatasetConfig& c) {

@@ -71,6 +71,7 @@ std::string canonical_text(const DatasetConfig& c) {
   t += fmt::format("degree: {}\nrepresentations: [{}, {}, {}]\nsplit: [{}, {}, {}]\nshard_size: {}\n", c.degree,
                    r.point_cloud, r.grid, r.grid_size, num(c.split.train), num(c.split.val), num(c.split.test),
                    c.shard_size);
+  if (c.quadrature) t += fmt::format("quadrature: {}\n", c.quadrature);  // only when given, as below
   if (r.error_estimate) t += "error_estimate: true\n";  // only when asked for: older datasets keep their identity
   if (const auto& a = c.accuracy; a.enabled())  // likewise
     t += fmt::format("accuracy: [{}, {}, {}]\n", num(a.rel_l2), a.max_level, num(a.exceed_share));

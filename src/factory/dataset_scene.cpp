@@ -93,7 +93,7 @@ ShapeProblem make_shape_problem(MPI_Comm group, const config::DatasetConfig& cfg
                                 const LoadCase& first_case, std::optional<physics::SpaceOptions> space) {
   ShapeProblem out;
   out.problem = physics::build_problem(group, shape.mesh, cfg.source, resolve_scene(cfg, shape, first_case),
-                                       cfg.shapes.dim, space.value_or(physics::SpaceOptions{cfg.degree}), true);
+                                       cfg.shapes.dim, space.value_or(physics::SpaceOptions{cfg.degree, cfg.quadrature}), true);
   return out;
 }
 

@@ -20,7 +20,7 @@ LabelErrorEstimator::LabelErrorEstimator(MPI_Comm group, const config::DatasetCo
   fine_shape_.dirichlet_center = shape.dirichlet_center;
   fine_shape_.dirichlet_radius = shape.dirichlet_radius;
   fine_shape_.mesh = refined_.mesh;
-  fine_ = make_shape_problem(group, cfg, fine_shape_, first, physics::SpaceOptions{coarse.space().degree()});
+  fine_ = make_shape_problem(group, cfg, fine_shape_, first, physics::SpaceOptions{coarse.space().degree(), cfg.quadrature});
   // The mean-dilatation element: Newton to tolerance on the fine mesh (TwoLevelEstimator).
   estimator_ = std::make_unique<solver::TwoLevelEstimator>(coarse, *fine_.problem, refined_,
                                                            newton_to_tolerance || cfg.material.dilatation == "mean");

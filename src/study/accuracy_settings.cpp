@@ -25,7 +25,7 @@ struct SettingsBuilder {
 
   void add(Setting s) {
     s.baseline_discretisation =
-        s.h == h0 && s.degree == p0 && s.quadrature == 0 && !s.linear_model && s.load_rotation == 0;
+        s.h == h0 && s.degree == p0 && s.quadrature == base.quadrature && !s.linear_model && s.load_rotation == 0;
     s.is_default = s.group == "mesh" && s.h == h0 && s.degree == p0;
     // 3D: MUMPS everywhere beyond kAutoMumpsDofs, the baseline included: PETSc's own Cholesky
     // (the one-rank default) took 233 s for one load case of the ball at P1 h 0.1 (25k unknowns,
@@ -52,7 +52,7 @@ void add_mesh_grid(SettingsBuilder& b, std::vector<double> sizes, double ref_h) 
       Setting s = b.base;
       s.degree = p;
       s.h = h;
-      s.name = fmt::format("P{} h{}", p, fmt_g(h));
+      s.name = fmt::format("P{} h{}{}", p, fmt_g(h), s.quadrature ? fmt::format(" quad {}", s.quadrature) : "");
       s.group = "mesh";
       b.add(s);
     }
@@ -122,6 +122,7 @@ std::vector<Setting> make_settings(int dim, const AccuracyOptions& a, const conf
   b.base.degree = b.p0;
   b.base.h = b.h0;
   b.base.opt = cfg.solver;
+  b.base.quadrature = cfg.quadrature;  // an --override of mesh.quadrature: every setting's rule, not the reference's
   // First: the baseline discretisation at tight tolerances (the solver-error yardstick).
   if (dim == 2)
     b.knob("tolerance", "tight", [](Setting& s) {

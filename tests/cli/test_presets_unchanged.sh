@@ -15,8 +15,9 @@
 # out, and preset_r3s is the preset, fingerprinted when it moved. On 2026-11-27 the corrector
 # began to give up a creeping increment (CreepWatch, issue 23): r2's shape 0, load 0 takes one
 # Newton iteration fewer (newton_iterations and recovery_iterations updated; u unchanged).
-# On 2026-11-28 the random2d preset moved to P2 at h 0.12 (issue 15): preset_r2.yaml writes the
-# former preset out (only its stored config text was updated), and preset_r2p is the preset.
+# On 2026-11-28 the random2d preset moved to P2 at h 0.12 (issue 15): preset_r2.yaml now starts
+# from random2d_p1, the former preset under a new name (only its stored config text was updated:
+# the arrays are those made before), and preset_r2p is the preset itself.
 # Needs HYPERSHAPE_BIN and HYPERSHAPE_SOURCE_DIR (set by CTest).
 . "$(dirname "$0")/lib.sh"
 for name in r2 r2p e2 r3 r3m r3s; do

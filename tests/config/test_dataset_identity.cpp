@@ -60,7 +60,7 @@ preset: random2d
 TEST_CASE("a different value is a different dataset", "[config][identity]") {
   const std::string a = canonical(base);
   for (const char* change : {"seed: 4\n", "loads: {count: 3, target: [0.1, 0.4]}\n", "material: {E: 501}\n",
-                             "mesh: {degree: 1}\n", "petsc: {pc_type: lu}\n", "output: {shard_size: 2}\n",
+                             "mesh: {degree: 1}\n", "mesh: {quadrature: 2}\n", "petsc: {pc_type: lu}\n", "output: {shard_size: 2}\n",
                              "solver: {linear: gamg}\n", "solver: {linear_auto_dofs: 1000}\n",
                              "solver: {abandon_off_path: true}\n", "solver: {arc_length_rescue: false}\n",
                              "solver: {retry_from_rest: false}\n",
@@ -71,6 +71,20 @@ TEST_CASE("a different value is a different dataset", "[config][identity]") {
     CAPTURE(change);
     CHECK(canonical(t + change) != a);
   }
+}
+
+TEST_CASE("mesh.quadrature: in the identity only when given; refused below what the degree needs",
+          "[config][identity]") {
+  // The default written out is the same value but another identity only if given: older
+  // datasets keep theirs (the canonical text has no quadrature line without the key).
+  CHECK(canonical(base).find("quadrature") == std::string::npos);
+  CHECK(config::parse_dataset_text(std::string(base) + "mesh: {quadrature: 2}\n", "t").quadrature == 2);
+  CHECK_THAT(error_of(std::string(base) + "mesh: {quadrature: 1}\n"),
+             Catch::Contains("mesh.quadrature: must be an integer in [2, 8]"));  // the preset is P2
+  CHECK(error_of(std::string(base) + "mesh: {degree: 1, quadrature: 1}\n").empty());
+  CHECK_THAT(error_of(std::string(base) + "mesh: {degree: 1, quadrature: 1}\naccuracy: {rel_l2: 0.01}\n"),
+             Catch::Contains("mesh.quadrature: 1 with accuracy"));
+  CHECK_THAT(error_of(std::string(base) + "mesh: {quadrature: 9}\n"), Catch::Contains("mesh.quadrature"));
 }
 
 TEST_CASE("YAML that yaml-cpp accepts silently is an input error naming the key", "[config][yaml]") {

@@ -34,7 +34,7 @@ std::string shipped_livers() { return std::string(HS_SOURCE_DIR) + "/configs/sur
 
 }  // namespace
 
-TEST_CASE("the paper's eight presets are embedded and parse by name as from their files",
+TEST_CASE("the paper's eight presets (and random2d_p1) are embedded and parse by name as from their files",
           "[config][presets]") {
   std::set<std::string> names;
   for (const auto& p : config::presets()) {
@@ -49,8 +49,24 @@ TEST_CASE("the paper's eight presets are embedded and parse by name as from thei
     CHECK(a.shapes.base_files == b.shapes.base_files);
   }
   for (const char* n : {"random2d", "easy_random2d", "ood_random2d", "one_random2d", "random3d",
-                        "aug_liver", "liver", "one_liver"})
+                        "aug_liver", "liver", "one_liver", "random2d_p1"})
     CHECK(names.count(n) == 1);
+}
+
+TEST_CASE("random2d is P2 at h 0.12; random2d_p1 is the former P1 preset with the same family",
+          "[config][presets]") {
+  const auto p2 = by_name("preset: random2d\n"), p1 = by_name("preset: random2d_p1\n");
+  CHECK((p2.degree == 2 && p2.shapes.h == 0.12));
+  CHECK((p1.degree == 1 && p1.shapes.h == 0.04 && p1.shapes.min_feature_fraction == 0.1));
+  // The same shape family: flows, patch, loads, and the same absolute neck threshold (0.004).
+  const auto& a = p2.shapes.deformation.steps;
+  const auto& b = p1.shapes.deformation.steps;
+  REQUIRE(a.size() == b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) CHECK((a[i].sigma == b[i].sigma && a[i].m == b[i].m));
+  CHECK(p2.shapes.dirichlet_radius == p1.shapes.dirichlet_radius);
+  CHECK((p2.n_shapes == p1.n_shapes && p2.loads.count == p1.loads.count && p2.seed == p1.seed));
+  CHECK(p2.shapes.min_feature_fraction * p2.shapes.h == Approx(0.004).epsilon(1e-3));
+  CHECK(p1.shapes.min_feature_fraction * p1.shapes.h == Approx(0.004).epsilon(1e-12));
 }
 
 TEST_CASE("liver and one_liver: one shape per shipped surface file, no deformation",

@@ -3,9 +3,15 @@
 #include <catch2/catch.hpp>
 
 #include <set>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "hypershape/config/dataset.hpp"
 #include "hypershape/factory/dataset_scene.hpp"
+#include "hypershape/factory/load_cases.hpp"
+#include "hypershape/factory/shape_pipeline.hpp"
+#include "hypershape/physics/problem.hpp"
 
 using namespace hypershape;
 
@@ -40,4 +46,16 @@ effects:
   CHECK(E.size() == 4);
   CHECK(gammas.size() == 20);
   CHECK(factory::n_tractions(c) == 2);
+}
+
+TEST_CASE("mesh.quadrature reaches the space: P2 at exactness 2 has 3 points per triangle, else 6",
+          "[factory][scene]") {
+  for (const auto& [line, n_qp] : std::vector<std::pair<std::string, int>>{{"", 6}, {"mesh: {quadrature: 2}\n", 3}}) {
+    const auto c = config::parse_dataset_text("preset: random2d\nshapes: {count: 1}\nloads: {count: 1}\n" + line, "<test>");
+    const auto shape = factory::make_shape(c.shapes, std::nullopt, c.seed, 0);
+    const auto loads = factory::draw_load_cases(shape, c.loads, c.seed);
+    const auto sp = factory::make_shape_problem(PETSC_COMM_SELF, c, shape, loads[0]);
+    CHECK(sp.problem->space().degree() == 2);
+    CHECK(sp.problem->space().n_qp() == n_qp);
+  }
 }

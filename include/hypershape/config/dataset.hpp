@@ -120,6 +120,7 @@ struct DatasetConfig {
   physics::SceneSpec scene;
   bool scene_given = false;  ///< `effects:` was written (else: the shorthands)
   int degree = 1;
+  int quadrature = 0;  ///< mesh.quadrature: exactness of the cell rule; 0: 2 * degree - 1
   RepresentationsConfig representations;
   AccuracyConfig accuracy;
   SplitConfig split;
