@@ -418,8 +418,9 @@ void parse_mesh(const YamlBlock& top, const std::string& source, DatasetConfig& 
       m.fail("rim", "must be in (0, mesh.h] (edge length at the clamp rim)");
     c.shapes.rim_size = rim;
   }
-  m.allowed("degree, quadrature (exactness of the cell rule), h (3D: mesh edge length when coarser than shapes.h), surface_h (3D: surface edge "
-            "length, shapes.h keeps it as drawn), rim (3D: edge length at the clamp rim)");
+  m.allowed("degree, quadrature (exactness of the cell rule), h (3D: mesh edge length when coarser than "
+            "shapes.h), surface_h (3D: surface edge length, shapes.h keeps it as drawn), rim (3D: edge length "
+            "at the clamp rim)");
   m.check_all_used();
 }
 

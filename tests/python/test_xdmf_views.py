@@ -23,7 +23,7 @@ sys.path.insert(0, os.path.join(src, "tests", "python"))
 import xdmf_readers as xr  # noqa: E402
 
 CONFIGS = {
-    "x2d": "preset: random2d\nname: x2d\nseed: 5\nshapes: {count: 3, h: 0.1}\nloads: {count: 3}\n"
+    "x2d": "preset: random2d_p1\nname: x2d\nseed: 5\nshapes: {count: 3, h: 0.1}\nloads: {count: 3}\n"
            "representations: {grid_size: 8}\noutput: {shard_size: 2}\n",
     "x3d": "preset: random3d\nname: x3d\nseed: 7\nshapes: {count: 1}\nloads: {count: 2}\n"
            "representations: {grid_size: 8}\n",

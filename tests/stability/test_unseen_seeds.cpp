@@ -107,7 +107,7 @@ TEST_CASE("Unseen-seed load cases that need a branch switch end stable on target
 /// DEG=1|2 with that element degree: whether a load case fails at every resolution
 /// (docs/STABILITY.md, "Which discretisation loses these load cases"):
 ///   CONFIG=p2-8888.yaml SEED=8888 SHAPE=9 LOAD=2 FROM=2 REFINE=2 DEG=1 unit_tests "[unseen_replay]"
-/// (p2-8888.yaml: {preset: random2d, seed: 8888, shapes: {count: 20, h: 0.12}, mesh: {degree: 2},
+/// (p2-8888.yaml: {preset: random2d_p1, seed: 8888, shapes: {count: 20, h: 0.12}, mesh: {degree: 2},
 /// loads: {count: 50}}).
 TEST_CASE("Replay one shape's load cases as the factory does", "[.][unseen_replay]") {
   const char* config = std::getenv("CONFIG");

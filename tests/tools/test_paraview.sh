@@ -20,7 +20,7 @@ if ((${#missing[@]})); then
     { fail "cannot install ${missing[*]}"; finish; exit 1; }
 fi
 
-printf 'preset: random2d\nname: pv2\nseed: 5\nshapes: {count: 3, h: 0.1}\nloads: {count: 3}\nrepresentations: {grid_size: 8}\noutput: {shard_size: 2}\n' > "$work/pv2.yaml"
+printf 'preset: random2d_p1\nname: pv2\nseed: 5\nshapes: {count: 3, h: 0.1}\nloads: {count: 3}\nrepresentations: {grid_size: 8}\noutput: {shard_size: 2}\n' > "$work/pv2.yaml"
 printf 'preset: random3d\nname: pv3\nseed: 7\nshapes: {count: 1}\nloads: {count: 2}\nrepresentations: {grid_size: 8}\n' > "$work/pv3.yaml"
 for name in pv2 pv3; do
   "$bin" -q generate "$work/$name.yaml" --progress 0 -o "$work/$name" || { fail "$name: generate"; continue; }
