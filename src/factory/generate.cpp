@@ -494,7 +494,7 @@ RunReport generate(MPI_Comm comm, const config::DatasetConfig& cfg, const Genera
   rep.shards_total = (cfg.n_shapes + S - 1) / S;
   // The base surface is read (and so checked) before anything is written.
   const std::optional<geometry::Boundary> base = load_dataset_base(cfg);
-  const DatasetEstimate est = estimate_dataset(cfg);
+  const DatasetEstimate est = estimate_dataset(cfg, base);
   OutputState out = prepare_run(comm, cfg, opt, est, rep.shards_total);
   rep.shards_done_before = out.done_before;
   HS_PETSC(PetscLogDefaultBegin());

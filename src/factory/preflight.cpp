@@ -10,21 +10,38 @@
 
 #include "hypershape/core/error.hpp"
 #include "hypershape/factory/accuracy.hpp"
+#include "hypershape/factory/dataset_scene.hpp"
+#include "hypershape/factory/shape_pipeline.hpp"
 #include "hypershape/io/dataset_shard.hpp"
 
 namespace hypershape::factory {
 
 namespace fs = std::filesystem;
 
-DatasetEstimate estimate_dataset(const config::DatasetConfig& cfg) {
-  // A shape fills about 2.5 of the box's 4 (2D) / 8 (3D); vertices of a simplex mesh of size h:
-  // 1.15 / h^2 per area, 1.5 / h^3 per volume; P2 adds edge nodes (x4 in 2D, x8 in 3D).
+namespace {
+
+/// 2D: the vertices of shape 0 as the dataset draws and meshes it (0 if it has no acceptable draw).
+double pilot_vertices(const config::DatasetConfig& cfg, const std::optional<geometry::Boundary>& base) {
+  try {
+    return double(make_shape(shape_config(cfg, 0), base, cfg.seed, 0).mesh.n_vertices());
+  } catch (const std::runtime_error&) {
+    return 0.0;
+  }
+}
+
+}  // namespace
+
+DatasetEstimate estimate_dataset(const config::DatasetConfig& cfg, const std::optional<geometry::Boundary>& base) {
+  // 3D: a shape fills about 2.5 of the box's 8; vertices of a tetrahedral mesh of size h: 1.5 / h^3
+  // per volume. 2D: shape 0's mesh (without a draw: 2.5 of the box's 4, 1.15 / h^2 per area).
+  // P2 adds edge nodes (x4 in 2D, x8 in 3D); a uniform refinement multiplies the vertices by 4 / 8.
   // A dataset asked for by accuracy: at its ladder's level 1 (a shape's level is known only once
   // it is solved; Random2D at rel_l2 0.01 went to level 2, 4x these sizes: docs/ACCURACY.md).
   const int d = cfg.shapes.dim;
   const AccuracyLevel level = accuracy_level(cfg, cfg.accuracy.enabled() ? std::min(1, cfg.accuracy.max_level) : 0);
   const double h = level.h;
-  const double vertices = d == 2 ? 2.5 * 1.15 / (h * h) : 2.5 * 1.5 / (h * h * h);
+  const double pilot = d == 2 ? pilot_vertices(cfg, base) * std::pow(4.0, level.refinements) : 0.0;
+  const double vertices = pilot > 0 ? pilot : d == 2 ? 2.5 * 1.15 / (h * h) : 2.5 * 1.5 / (h * h * h);
   const double n = vertices * (level.degree == 1 ? 1.0 : (d == 2 ? 4.0 : 8.0));
   const double grid = cfg.representations.grid ? std::pow(double(cfg.representations.grid_size), d) : 0.0;
   const double pc = cfg.representations.point_cloud ? 1.0 : 0.0;
@@ -36,11 +53,13 @@ DatasetEstimate estimate_dataset(const config::DatasetConfig& cfg) {
   // noisy floats. Measured: random2d 1 shape x 50 load cases 16 MB estimated / 10.8 MB written;
   // a 2D slice at h 0.1 with 64^2 grids 2.0 / 2.9 MB; random3d 1 x 4 28 / 16 MB.
   e.bytes_per_shape = per_shape + cfg.loads.count * per_load + 50e3;
-  // Measured per load case (setup, solve, alpha search, representations): 2D P1 3.9k unknowns
-  // 0.06 s, 3D P2 3.3k unknowns 7 s; cost grows faster than the unknowns.
+  // Measured per load case (the phases of `scripts/bench_generate.sh`, 1 rank, 2026-11-28): 2D P1
+  // 5.3k unknowns 0.034-0.044 s, 2D P2 13.5k unknowns 0.15-0.22 s (random2d_p1, random2d; two
+  // seeds); 3D P2 3.3k unknowns 7 s; cost grows faster than the unknowns.
   const double dofs = n * d;
+  const double c = d == 3 ? 1.9e-4 : level.degree == 1 ? 5.6e-7 : 7.9e-7;
   // A shape costs its draw and mesh too (~0.2 s in 2D, ~5 s in 3D at the presets' sizes).
-  e.cpu_seconds_per_load = 0.02 + (d == 2 ? 1.2e-6 : 1.9e-4) * std::pow(dofs, 1.3);
+  e.cpu_seconds_per_load = 0.005 + c * std::pow(dofs, 1.3);
   e.bytes = e.bytes_per_shape * double(cfg.n_shapes);
   e.cpu_seconds = (e.cpu_seconds_per_load * cfg.loads.count + (d == 2 ? 0.2 : 5.0)) * double(cfg.n_shapes);
   return e;
