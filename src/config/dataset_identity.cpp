@@ -53,7 +53,7 @@ std::string solver_text(const solver::SolverOptions& s) {
          linear +
          (s.step_growth != solver::SolverOptions{}.step_growth ? "  step_growth: " + num(s.step_growth) + "\n" : "") +
          (s.abandon_off_path ? "  abandon_off_path: true\n" : "") +  // likewise only when asked for
-         (s.arc_length_rescue ? "" : "  arc_length_rescue: false\n") +  // only when turned off
+         (s.arc_length_rescue ? "  arc_length_rescue: true\n" : "") +  // only when turned on (the default since 2026-11-28)
          (s.retry_from_rest ? "" : "  retry_from_rest: false\n") +
          (s.tangent.single_factor ? "  factor_precision: single\n" : "");
 }
