@@ -107,10 +107,12 @@ struct SolverOptions {
   /// that failed before it ran change (measured: 3000 Random2D load cases of unseen seeds, every
   /// other array bit for bit; docs/STABILITY.md, "Seeds nobody tuned on"). In 2D only: on the random3d
   /// preset (seed 90210, 200 load cases) it rescued none (0 of 1) for 5% more Newton iterations.
-  /// Off by default since 2026-11-28: the branch switches now solve the two load cases it was
-  /// measured to rescue, and on 10 000 Random2D load cases of five unseen seeds (P1 and P2, 20 x
-  /// 50 each) it rescued none, for 3.8% of all Newton iterations at P2 (0.6% at P1); every label
-  /// the same without it (docs/STABILITY.md, "The arc-length rescue, off by default").
+  /// Off by default since 2026-11-28: the two load cases it was measured to rescue are solved
+  /// without it (777/11/20 by the branch switches, 31337/13/10 by the retry from rest, at the same
+  /// equilibrium), and on 14 000 load cases of four 2D presets (five unseen seeds of Random2D at
+  /// P1 and P2, two of OODRandom2D and EasyRandom2D) it rescued none, for 3.8% of all Newton
+  /// iterations at P2 (0.6% at P1); every label the same without it (docs/STABILITY.md, "The
+  /// arc-length rescue, off by default").
   bool arc_length_rescue = false;
   /// Displacement control failed (after the switches and the rescue; not at a verified fold) on
   /// a path whose first increment was the previous load case's (the hint): solve it once more from
