@@ -350,7 +350,7 @@ TEST_CASE("Failed increments are recovered and their cost counted; a spent budge
     INFO(t.reason);
     CHECK_FALSE(t.converged);
     CHECK_THAT(t.reason, Catch::Contains("budget"));
-    // The arc-length rescue is off by default (it rescued none of 14 000 load cases): not run.
+    // The arc-length rescue is off by default (no load case of 14 000 needed it): not run.
     CHECK(t.reason.find("arc-length") == std::string::npos);
     // The path (its branch switches included) and each rescue after it have a budget each.
     CHECK(t.newton_iterations <= 2 * o.newton_budget);
