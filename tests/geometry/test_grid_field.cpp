@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 #include "hypershape/core/random.hpp"
@@ -47,8 +48,8 @@ TEST_CASE("GRF samples have zero mean and the Gaussian covariance", "[geometry][
     core::RandomStream rng(7, core::Purpose::test, {std::uint64_t(s)});
     const GridField v = geometry::sample_velocity_field(g, sigma, m, rng);
     for (std::size_t p = 0; p < pairs.size(); ++p) {
-      const double va = v.component(0)[pairs[p].a], vb = v.component(0)[pairs[p].b];
-      const double wb = v.component(1)[pairs[p].b];
+      const double va = v.at(pairs[p].a, 0), vb = v.at(pairs[p].b, 0);
+      const double wb = v.at(pairs[p].b, 1);
       mean[p] += va;
       cov[p] += va * vb;
       cross[p] += va * wb;
@@ -82,8 +83,8 @@ TEST_CASE("3D GRF samples match the kernel", "[geometry][grf]") {
   for (int s = 0; s < n_samples; ++s) {
     core::RandomStream rng(11, core::Purpose::test, {std::uint64_t(s)});
     const GridField v = geometry::sample_velocity_field(g, sigma, m, rng);
-    caa += v.component(2)[a] * v.component(2)[a];
-    cab += v.component(2)[a] * v.component(2)[b];
+    caa += v.at(a, 2) * v.at(a, 2);
+    cab += v.at(a, 2) * v.at(b, 2);
   }
   caa /= n_samples;
   cab /= n_samples;
@@ -131,8 +132,8 @@ TEST_CASE("Catmull-Rom interpolation is third order", "[geometry][grf]") {
     double x[3];
     for (std::int64_t i = 0; i < g.n_nodes(); ++i) {
       field.node_coords(i, x);
-      field.component(0)[i] = f(x);
-      field.component(1)[i] = 2.0 * f(x);
+      field.at(i, 0) = f(x);
+      field.at(i, 1) = 2.0 * f(x);
     }
     core::RandomStream rng(3, core::Purpose::test, {});
     double err = 0.0, val[2];
@@ -178,8 +179,8 @@ struct BumpVelocity {
     for (std::int64_t i = 0; i < g.n_nodes(); ++i) {
       field.node_coords(i, x);
       (*this)(x, w);
-      field.component(0)[i] = w[0];
-      field.component(1)[i] = w[1];
+      field.at(i, 0) = w[0];
+      field.at(i, 1) = w[1];
     }
     return field;
   }
@@ -263,7 +264,7 @@ TEST_CASE("scaling and squaring converges and its inverse is the identity", "[ge
     const GridField v = geometry::sample_velocity_field(g, 0.2, 0.1, rng);
     GridField minus_v(g);
     for (int c = 0; c < 2; ++c)
-      for (std::int64_t i = 0; i < g.n_nodes(); ++i) minus_v.component(c)[i] = -v.component(c)[i];
+      for (std::int64_t i = 0; i < g.n_nodes(); ++i) minus_v.at(i, c) = -v.at(i, c);
     const int n_sq = geometry::default_squarings(v);
     const GridField up = geometry::exponentiate(v, n_sq), um = geometry::exponentiate(minus_v, n_sq);
     double err = 0.0;
@@ -282,4 +283,67 @@ TEST_CASE("scaling and squaring converges and its inverse is the identity", "[ge
   CHECK(moved > 0.1);
   CHECK(inverse_errors[1] < 2e-2 * moved);  // the 2D default
   CHECK(inverse_errors[2] < inverse_errors[0] / 8);
+}
+
+namespace {
+
+/// The Catmull-Rom sum written out plainly, one component at a time over the 4^dim nodes in the
+/// order (z, y, x), w = (w_z w_y) w_x: the arithmetic evaluate() must do, lane by lane.
+void reference_evaluate(const GridField& f, const double* x, double* out) {
+  const Grid& g = f.grid();
+  int ix[3][4];
+  double wx[3][4];
+  for (int a = 0; a < 3; ++a) {
+    if (g.n[a] == 1) {
+      for (int q = 0; q < 4; ++q) ix[a][q] = 0, wx[a][q] = q == 1 ? 1.0 : 0.0;
+      continue;
+    }
+    const double s = std::clamp((x[a] - g.lower[a]) / g.spacing, 0.0, double(g.n[a] - 1));
+    const int i = std::min(int(s), g.n[a] - 2);
+    const double t = s - i, t2 = t * t, t3 = t2 * t;
+    wx[a][0] = 0.5 * (-t3 + 2.0 * t2 - t);
+    wx[a][1] = 0.5 * (3.0 * t3 - 5.0 * t2 + 2.0);
+    wx[a][2] = 0.5 * (-3.0 * t3 + 4.0 * t2 + t);
+    wx[a][3] = 0.5 * (t3 - t2);
+    for (int q = 0; q < 4; ++q) ix[a][q] = std::clamp(i - 1 + q, 0, g.n[a] - 1);
+  }
+  for (int d = 0; d < g.dim; ++d) {
+    double acc = 0.0;
+    for (int c = 0; c < (g.dim == 3 ? 4 : 1); ++c)
+      for (int b = 0; b < 4; ++b) {
+        const double wyz = (g.dim == 3 ? wx[2][c] : 1.0) * wx[1][b];
+        for (int a = 0; a < 4; ++a) {
+          const std::int64_t node = ix[0][a] + std::int64_t(g.n[0]) * (ix[1][b] + std::int64_t(g.n[1]) * ix[2][c]);
+          acc += (wyz * wx[0][a]) * f.at(node, d);
+        }
+      }
+    out[d] = acc;
+  }
+}
+
+}  // namespace
+
+TEST_CASE("evaluation at many points is the plain Catmull-Rom sum to the bit", "[geometry][grf]") {
+  for (int dim : {2, 3}) {
+    const Grid g = square_grid(dim, 1.0, 0.1);
+    core::RandomStream rng(11, core::Purpose::test, {std::uint64_t(dim)});
+    const GridField v = geometry::sample_velocity_field(g, 0.3, 1.0, rng);
+    // 4k + 3 points (the fours and the tail), inside, near and beyond the grid's faces.
+    const std::size_t n = 103;
+    std::vector<double> x(n * std::size_t(dim)), many(x.size()), one(static_cast<std::size_t>(dim)), ref(one);
+    for (double& c : x) c = -1.4 + 2.8 * rng.uniform();
+    v.evaluate(n, x.data(), many.data());
+    int differ = 0;
+    for (std::size_t p = 0; p < n; ++p) {
+      v.evaluate(&x[p * std::size_t(dim)], one.data());
+      reference_evaluate(v, &x[p * std::size_t(dim)], ref.data());
+      for (int d = 0; d < dim; ++d) {
+        const double m = many[p * std::size_t(dim) + std::size_t(d)];
+        differ += std::memcmp(&m, &one[std::size_t(d)], sizeof m) != 0;
+        differ += std::memcmp(&m, &ref[std::size_t(d)], sizeof m) != 0;
+      }
+    }
+    INFO("dim " << dim);
+    CHECK(differ == 0);
+  }
 }

@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdint>
 #include <span>
+#include <cstddef>
 #include <vector>
 
 #include "hypershape/core/random.hpp"
@@ -24,7 +25,8 @@ struct Grid {
 };
 
 /// A field of `dim` components at the nodes of a grid (node (i, j, k) has index
-/// i + n0 * (j + n1 * k)). Evaluation between nodes is tensor-product Catmull-Rom: C1 and exact
+/// i + n0 * (j + n1 * k)), stored node by node (the components of a node side by side, as
+/// evaluation reads them). Evaluation between nodes is tensor-product Catmull-Rom: C1 and exact
 /// for quadratics, so the interpolation error is O(spacing^3); outside the grid the field is
 /// continued by its value at the nearest node.
 class GridField {
@@ -32,23 +34,24 @@ class GridField {
   explicit GridField(const Grid& grid);
   const Grid& grid() const { return grid_; }
   int dim() const { return grid_.dim; }
-  /// Values of component c at all nodes.
-  std::span<double> component(int c) {
-    return {values_.data() + c * grid_.n_nodes(), std::size_t(grid_.n_nodes())};
-  }
-  std::span<const double> component(int c) const {
-    return {values_.data() + c * grid_.n_nodes(), std::size_t(grid_.n_nodes())};
-  }
+  /// Component c at node `node`.
+  double& at(std::int64_t node, int c) { return values_[std::size_t(node * grid_.dim + c)]; }
+  double at(std::int64_t node, int c) const { return values_[std::size_t(node * grid_.dim + c)]; }
   /// Coordinates of node `node` (dim entries written to x).
   void node_coords(std::int64_t node, double* x) const;
   /// Interpolated value at x (dim coordinates in, dim components out).
   void evaluate(const double* x, double* value) const;
+  /// The same at n points (x: n x dim coordinates, values: n x dim components), each to the bit
+  /// what evaluate(x, value) gives it alone, in a quarter of the time: four points at a time,
+  /// each point's sum in the same order, their additions overlapping in the CPU.
+  void evaluate(std::size_t n, const double* x, double* values) const;
   /// Largest Euclidean norm over the nodes.
   double max_norm() const;
 
  private:
   Grid grid_;
-  std::vector<double> values_;
+  std::vector<double> values_;  ///< node-major; one spare entry at the end (a 3D node's values
+                                ///< are read as four lanes, the fourth unused)
 };
 
 /// Samples a velocity field whose components are independent zero-mean Gaussian random fields
