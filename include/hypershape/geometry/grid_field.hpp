@@ -42,8 +42,8 @@ class GridField {
   /// Interpolated value at x (dim coordinates in, dim components out).
   void evaluate(const double* x, double* value) const;
   /// The same at n points (x: n x dim coordinates, values: n x dim components), each to the bit
-  /// what evaluate(x, value) gives it alone, in a quarter of the time: four points at a time,
-  /// each point's sum in the same order, their additions overlapping in the CPU.
+  /// what evaluate(x, value) gives it alone, and faster: four points at a time, each point's sum
+  /// in the same order, their additions overlapping in the CPU.
   void evaluate(std::size_t n, const double* x, double* values) const;
   /// Largest Euclidean norm over the nodes.
   double max_norm() const;
