@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <numeric>
@@ -95,6 +96,24 @@ json manifest_json(const config::DatasetConfig& cfg, const std::string& hash, co
           {"shards", std::move(shards)}};
 }
 
+}  // namespace
+
+bool IndexReport::mixed_numerics() const {
+  return std::count_if(numerics.begin(), numerics.end(), [](const auto& p) { return !p.first.empty(); }) > 1;
+}
+
+std::string IndexReport::mixed_numerics_warning() const {
+  if (!mixed_numerics()) return "";
+  std::string kinds;
+  for (const auto& [platform, ks] : numerics)
+    if (!platform.empty()) kinds += fmt::format("\n  {} shard(s) from \"{}\" (first: {})", ks.size(), platform, ks.front());
+  return "warning: the shards were written on machines of different kinds:" + kinds +
+         "\n  the dataset is valid, but not bit for bit what one machine makes (labels agree to round-off, "
+         "a shape may mesh differently); README, \"On machines of different kinds\"";
+}
+
+namespace {
+
 using ShapesById = std::map<std::int64_t, const io::ShardSummary::Shape*>;
 
 /// splits.json: the seeded split of the shape ids, failed shapes in none. Returns the splits.
@@ -163,9 +182,13 @@ IndexReport index_dataset(const std::string& dir) {
       throw std::runtime_error(p.string() + ": " + problem + "; run `hypershape generate` on this directory "
                                "with its config again: it redoes the shard");
     summaries.push_back(io::read_shard_summary(p.string()));
+    rep.numerics[summaries.back().header.software["numerics"]].push_back(k);
     shards.push_back(shard_entry(k, p, summaries.back(), rep, failed_shapes));
   }
-  write_json(root / "manifest.json", manifest_json(cfg, hash, rep, failed_shapes, std::move(shards)));
+  json manifest = manifest_json(cfg, hash, rep, failed_shapes, std::move(shards));
+  if (rep.mixed_numerics()) manifest["numerics_platforms"] = rep.numerics;  // (one kind: not written)
+  write_json(root / "manifest.json", manifest);
+  if (const std::string w = rep.mixed_numerics_warning(); !w.empty()) std::cerr << w << "\n";
   if (!rep.complete()) return rep;
   ShapesById by_id;
   for (const auto& s : summaries)

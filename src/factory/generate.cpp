@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "hypershape/config/scene.hpp"
+#include "hypershape/core/platform.hpp"
 #include "hypershape/core/collective.hpp"
 #include "hypershape/core/error.hpp"
 #include "hypershape/core/log.hpp"
@@ -88,7 +89,7 @@ double peak_rss_mib() {
 std::map<std::string, std::string> software_versions() {
   char petsc[256];
   PetscGetVersion(petsc, sizeof petsc);
-  return {{"petsc", petsc}, {"gmsh", mesh::gmsh_version()}};
+  return {{"petsc", petsc}, {"gmsh", mesh::gmsh_version()}, {"numerics", core::numerics_platform()}};
 }
 
 /// What rank 0 found and holds in the output directory.

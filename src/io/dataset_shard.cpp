@@ -277,6 +277,11 @@ ShardHeader read_header(hid_t file, const std::string& path) {
   h.first_shape = std::int64_t(read_attr_double(file, "first_shape"));
   h.n_shapes = std::int64_t(read_attr_double(file, "n_shapes"));
   h.n_loads = int(read_attr_double(file, "n_loads"));
+  // (shards written before 2026-11-28 have no numerics attribute)
+  if (H5Lexists(file, "software", H5P_DEFAULT) > 0) {
+    Id sw{check_id(H5Gopen2(file, "software", H5P_DEFAULT), path), H5Gclose};
+    if (H5Aexists(sw.id, "numerics") > 0) h.software["numerics"] = read_attr_string(sw.id, "numerics");
+  }
   return h;
 }
 

@@ -12,6 +12,7 @@
 /// atomically. Run by `generate` when it finds the dataset complete, or as
 /// `hypershape index DIR` after a SLURM array.
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,13 @@ struct IndexReport {
   std::int64_t shards = 0;
   std::vector<std::int64_t> missing_shards;
   std::int64_t shapes_ok = 0, shapes_failed = 0, loads_ok = 0, loads_failed = 0;
+  /// The shards by the numerics platform that wrote them (core::numerics_platform; "" for shards
+  /// of builds before 2026-11-28, which are not counted as a kind).
+  std::map<std::string, std::vector<std::int64_t>> numerics;
+  /// More than one known platform: the data are not bit for bit what one machine makes.
+  bool mixed_numerics() const;
+  /// The warning `index` prints (and manifest.json's `numerics_platforms`) then; else "".
+  std::string mixed_numerics_warning() const;
   bool complete() const { return missing_shards.empty(); }
 };
 
