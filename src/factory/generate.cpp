@@ -15,10 +15,10 @@
 #include <thread>
 
 #include "hypershape/config/scene.hpp"
-#include "hypershape/core/platform.hpp"
 #include "hypershape/core/collective.hpp"
 #include "hypershape/core/error.hpp"
 #include "hypershape/core/log.hpp"
+#include "hypershape/core/platform.hpp"
 #include "hypershape/core/timer.hpp"
 #include "hypershape/core/interrupt.hpp"
 #include "hypershape/factory/dataset_index.hpp"

@@ -32,7 +32,13 @@ void write_shard_record(const std::string& dir, const ShardIdentity& id, std::ui
   const nlohmann::json j = {{"shard", id.index},        {"config_hash", id.config_hash},
                             {"first_shape", id.first_shape}, {"n_shapes", id.n_shapes},
                             {"crc32", fmt::format("{:08x}", crc32)}, {"bytes", bytes}};
-  detail::write_atomically(record_path(dir, id.index), j.dump() + "\n");
+  try {
+    detail::write_atomically(record_path(dir, id.index), j.dump() + "\n");
+  } catch (const std::exception& e) {  // a full disk right after the shard: resumable as any
+    throw io::StorageError(fmt::format("{}; shard {} is written, its record not: the shards before it are complete, "
+                                       "run the same command again to resume",
+                                       e.what(), id.index));
+  }
 }
 
 namespace {

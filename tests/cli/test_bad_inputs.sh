@@ -194,9 +194,11 @@ if [ "$(id -u)" = 0 ] && mount -t tmpfs -o size=600k tmpfs "$fsdir" 2>/dev/null;
     ok "resources/full_at_start: exit 1, '$(tail -1 <<<"$msg" | cut -c1-120)', no file left"
   else fail "resources/full_at_start: exit $code, $left files left: $msg"; fi
   rm -f "$fsdir/fill"
-  # Fills mid-run (--force): shard 0 fits, shard 1 does not. Before HDF5 opens it (the free
-  # space check) and, on a larger disk, inside HDF5 (the failed flush that crashed at exit).
-  for size in 600k 900k; do
+  # Fills mid-run (--force), each size failing at another step: before HDF5 opens shard 0 (the
+  # free space check, 600k); right after shard 0, at its record (900k: shard 0 takes ~0.91 MB; an
+  # 88-byte attribute more moved this case from the check before shard 1 to the record); inside
+  # HDF5 at shard 1 (1650k: the failed flush that once crashed at exit).
+  for size in 600k 900k 1650k; do
     mount -o remount,size=$size "$fsdir"
     rm -rf "$fsdir/d"
     msg=$("$bin" generate "$work/six.yaml" --progress 0 -o "$fsdir/d" --force 2>&1 >/dev/null); code=$?
