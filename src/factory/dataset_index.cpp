@@ -182,7 +182,9 @@ IndexReport index_dataset(const std::string& dir) {
       throw std::runtime_error(p.string() + ": " + problem + "; run `hypershape generate` on this directory "
                                "with its config again: it redoes the shard");
     summaries.push_back(io::read_shard_summary(p.string()));
-    rep.numerics[summaries.back().header.software["numerics"]].push_back(k);
+    const auto& sw = summaries.back().header.software;
+    const auto numerics = sw.find("numerics");
+    rep.numerics[numerics == sw.end() ? "" : numerics->second].push_back(k);
     shards.push_back(shard_entry(k, p, summaries.back(), rep, failed_shapes));
   }
   json manifest = manifest_json(cfg, hash, rep, failed_shapes, std::move(shards));
