@@ -94,14 +94,15 @@ for tag in tags:
     ds.close()
     out[tag] = r
 json.dump(out, open(os.environ.get("JSON", "results/bench_stability.json"), "w"), indent=1)
-print("| family, seed | load cases | converged (95% CI) | target | Newton it./case mean, p50, p90, p99, max | p99 / p50 | recovery share | wall s |")
-print("|---|---|---|---|---|---|---|---|")
+print("| family, seed | load cases | converged (95% CI) | target | verified folds | Newton it./case mean, p50, p90, p99, max | p99 / p50 | recovery share | wall s |")
+print("|---|---|---|---|---|---|---|---|---|")
 for tag, r in out.items():
     fam = tag.split("-")[0]
     target.setdefault(fam, 99.9)
     it, (lo, hi) = r["newton_iterations"], r["converged_ci95_percent"]
     print(f"| {fam}, {tag.split('-', 1)[1]} | {r['load_cases']} | {r['converged_percent']:.2f}% ({lo:.2f}-{hi:.2f}) "
-          f"| >= {target[fam]}% | {it['mean']:.1f}, {it['median']:.0f}, {it['p90']:.0f}, {it['p99']:.0f}, {it['max']:.0f} "
+          f"| >= {target[fam]}% | {r['verified_folds']} "
+          f"| {it['mean']:.1f}, {it['median']:.0f}, {it['p90']:.0f}, {it['p99']:.0f}, {it['max']:.0f} "
           f"| {it['p99'] / max(it['median'], 1):.1f} | {100 * r['recovery_iterations']['share_of_newton_iterations']:.0f}% "
           f"| {r['run_report']['seconds']['wall']:.0f} |")
 for tag, r in out.items():

@@ -803,16 +803,19 @@ def check_dataset(path, out=sys.stdout):
 
 
 OUTCOMES = ("path", "branch switch from an unstable state", "branch switch after a stall",
-            "arc-length rescue", "retry from rest", "other", "failed", "shape failed")
+            "arc-length rescue", "retry from rest", "other", "failed", "failed at a verified fold",
+            "shape failed")
 
 
 def load_case_outcome(status, reason):
     """How a load case's solve ended, from its stored status and reason (docs/FORMAT.md): on the
     path itself, after a branch switch from an unstable state on target (a bifurcation or a
     fold) or from a stalled path, by the arc-length rescue, by the retry from rest without the
-    first-increment hint, otherwise converged, or failed."""
+    first-increment hint, otherwise converged, or failed: at a verified fold (max|u| = target only
+    on an unstable segment of the path: no stable equilibrium on target for any solver to find
+    there, docs/STABILITY.md) or otherwise."""
     if not status:
-        return "failed"
+        return "failed at a verified fold" if reason.startswith("fold:") else "failed"
     if reason == "target reached":
         return "path"
     if reason.startswith("target reached after a branch switch ("):
@@ -865,8 +868,12 @@ def solver_report(path):
     its, rec, status = np.array(its, float), np.array(rec, float), np.array(status)
     n = len(status)
     pct = lambda q: float(np.percentile(its, q)) if len(its) else 0.0  # noqa: E731
+    folds = by["failed at a verified fold"]["load_cases"]
     return {"dataset": path, "load_cases": n, "converged": int(status.sum()),
             "converged_percent": 100.0 * status.sum() / max(n, 1),
+            # the share of the load cases that have a stable equilibrium on target
+            "verified_folds": folds,
+            "converged_percent_without_folds": 100.0 * status.sum() / max(n - folds, 1),
             "failures_by_reason": dict(sorted(fails.items(), key=lambda kv: -kv[1])),
             "newton_iterations": {"total": int(its.sum()), "mean": float(its.mean()) if len(its) else 0.0,
                                   "median": pct(50), "p90": pct(90), "p99": pct(99),
@@ -881,7 +888,10 @@ def solver_report(path):
 def print_solver_report(r, out=sys.stdout):
     w = lambda s: print(s, file=out)  # noqa: E731
     it, rc = r["newton_iterations"], r["recovery_iterations"]
-    w(f"{r['dataset']}: {r['converged']}/{r['load_cases']} load cases converged ({r['converged_percent']:.2f}%)")
+    folds = r.get("verified_folds", 0)
+    w(f"{r['dataset']}: {r['converged']}/{r['load_cases']} load cases converged ({r['converged_percent']:.2f}%)"
+      + (f"; {folds} failed at a verified fold (no stable state on target), so "
+         f"{r['converged_percent_without_folds']:.2f}% of the others" if folds else ""))
     w(f"  Newton iterations per load case: mean {it['mean']:.1f}, median {it['median']:.0f}, "
       f"p90 {it['p90']:.0f}, p99 {it['p99']:.0f}, max {it['max']:.0f}; "
       f"{r['increments_per_load_case_mean']:.1f} increments per load case")

@@ -369,8 +369,9 @@ def solver_outcomes(path):
     r = hd.solver_report(path)
     by = r["by_outcome"]
     check(sum(v["load_cases"] for v in by.values()) == r["load_cases"]
-          and sum(by.get(o, {"load_cases": 0})["load_cases"] for o in ("failed", "shape failed"))
+          and sum(by.get(o, {"load_cases": 0})["load_cases"] for o in ("failed", "failed at a verified fold", "shape failed"))
           == r["load_cases"] - r["converged"]
+          and r["verified_folds"] == by.get("failed at a verified fold", {"load_cases": 0})["load_cases"]
           and by.get("shape failed", {"newton_iterations": 0})["newton_iterations"] == 0
           and sum(v["newton_iterations"] for v in by.values()) == r["newton_iterations"]["total"],
           f"solver report by outcome adds up to the load cases, failures and Newton iterations: {by}")
@@ -388,6 +389,9 @@ def solver_outcomes(path):
             "iterations spent)"): "retry from rest",
         (1, "target reached by load control (displacement control: ...)"): "other",
         (0, "target reached"): "failed",
+        (0, "fold: max|u| = target lies on an unstable segment of the path (at max|u| = 0.46, ...)"):
+            "failed at a verified fold",
+        (0, "Newton budget of 200 iterations spent (after a branch switch from: fold: max|u| = ...)"): "failed",
     }
     got = {k: hd.load_case_outcome(*k) for k in reasons}
     check(got == reasons, f"load_case_outcome classes the solver's reasons: {got}")
