@@ -811,9 +811,9 @@ def load_case_outcome(status, reason):
     """How a load case's solve ended, from its stored status and reason (docs/FORMAT.md): on the
     path itself, after a branch switch from an unstable state on target (a bifurcation or a
     fold) or from a stalled path, by the arc-length rescue, by the retry from rest without the
-    first-increment hint, otherwise converged, or failed: at a verified fold (max|u| = target only
-    on an unstable segment of the path: no stable equilibrium on target for any solver to find
-    there, docs/STABILITY.md) or otherwise."""
+    first-increment hint, otherwise converged, or failed: at a verified fold (the path from rest
+    passed a limit point of the load, so its state on target is unstable, and no branch switch
+    found a stable one: docs/STABILITY.md) or otherwise."""
     if not status:
         return "failed at a verified fold" if reason.startswith("fold:") else "failed"
     if reason == "target reached":
@@ -871,8 +871,7 @@ def solver_report(path):
     folds = by["failed at a verified fold"]["load_cases"]
     return {"dataset": path, "load_cases": n, "converged": int(status.sum()),
             "converged_percent": 100.0 * status.sum() / max(n, 1),
-            # the share of the load cases that have a stable equilibrium on target
-            "verified_folds": folds,
+            "verified_folds": folds,  # and the share converged of the other load cases:
             "converged_percent_without_folds": 100.0 * status.sum() / max(n - folds, 1),
             "failures_by_reason": dict(sorted(fails.items(), key=lambda kv: -kv[1])),
             "newton_iterations": {"total": int(its.sum()), "mean": float(its.mean()) if len(its) else 0.0,
@@ -890,7 +889,7 @@ def print_solver_report(r, out=sys.stdout):
     it, rc = r["newton_iterations"], r["recovery_iterations"]
     folds = r.get("verified_folds", 0)
     w(f"{r['dataset']}: {r['converged']}/{r['load_cases']} load cases converged ({r['converged_percent']:.2f}%)"
-      + (f"; {folds} failed at a verified fold (no stable state on target), so "
+      + (f"; {folds} failed at a verified fold (no stable state on target on the path or a switched branch), so "
          f"{r['converged_percent_without_folds']:.2f}% of the others" if folds else ""))
     w(f"  Newton iterations per load case: mean {it['mean']:.1f}, median {it['median']:.0f}, "
       f"p90 {it['p90']:.0f}, p99 {it['p99']:.0f}, max {it['max']:.0f}; "
