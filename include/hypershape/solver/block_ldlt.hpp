@@ -11,9 +11,25 @@
 /// of U is computed once per problem rather than at every factorisation's set-up.
 #include <petscsys.h>
 
+#include <cstddef>
+#include <new>
 #include <vector>
 
 namespace hypershape::solver {
+
+/// An allocator on 64-byte boundaries (a cache line): the factor's 2x2 blocks (32 bytes) are
+/// then each within one line, where malloc's 16-byte alignment splits every other one.
+template <class T>
+struct CacheLineAllocator {
+  using value_type = T;
+  CacheLineAllocator() = default;
+  template <class U>
+  CacheLineAllocator(const CacheLineAllocator<U>&) noexcept {}
+  T* allocate(std::size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t{64})); }
+  void deallocate(T* p, std::size_t) noexcept { ::operator delete(p, std::align_val_t{64}); }
+  friend bool operator==(CacheLineAllocator, CacheLineAllocator) { return true; }
+};
+using AlignedDoubles = std::vector<double, CacheLineAllocator<double>>;
 
 /// Negative eigenvalues of a block-diagonal D given by its nb inverted 2x2 blocks (4 each,
 /// column-major, as PETSc's blocked factor and BlockLdlt2 store them): a block and its inverse
@@ -43,11 +59,11 @@ class BlockLdlt2 {
   PetscInt nb_ = 0;
   std::vector<PetscInt> ai_, aj_;  ///< the matrix's upper block pattern
   std::vector<PetscInt> ui_, uj_;  ///< U's strictly upper block pattern (rows, columns)
-  std::vector<double> d_;          ///< D_k^-1, 4 per row, column-major
-  std::vector<double> u_;          ///< U's blocks, 4 each, column-major
+  AlignedDoubles d_;               ///< D_k^-1, 4 per row, column-major
+  AlignedDoubles u_;               ///< U's blocks, 4 each, column-major
   // Work arrays of the factorisation: a dense block row, and the linked lists of the rows
   // that update the row being factorised (next_[i]) and where row i's next block is (first_[i]).
-  std::vector<double> row_;
+  AlignedDoubles row_;
   std::vector<PetscInt> next_, first_;
 };
 
