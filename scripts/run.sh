@@ -5,7 +5,7 @@
 #   scripts/run.sh generate configs/presets/random2d.yaml  any hypershape command
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/setup.sh >/dev/null
+scripts/setup.sh hypershape_cli >/dev/null  # the CLI only (scripts/test.sh builds the rest)
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
 [ $# -eq 0 ] && set -- generate -o results/default
 np=${NP:-1}
