@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "hypershape/core/platform.hpp"
 #include "hypershape/config/dataset.hpp"
 #include "hypershape/factory/accuracy.hpp"
 #include "hypershape/factory/dataset_scene.hpp"
@@ -139,13 +140,22 @@ TEST_CASE("A load case lost on the hinted path is solved again from rest; the ne
   off.retry_from_rest = false;
   solver::NonlinearSolver without(*c.sp.problem, off);
   const auto lost = replay(c, without, 0, 47);
-  CHECK_FALSE(lost.converged);
   solver::NonlinearSolver with(*c.sp.problem, c.cfg.solver);
   const auto r = replay(c, with, 0, 47);
   INFO(r.reason);
-  CHECK(r.reason.rfind("target reached from rest without the first-increment hint (first try: ", 0) == 0);
-  CHECK(r.newton_iterations > lost.newton_iterations);  // the failed try counts, as recovery
-  CHECK(r.recovery_iterations >= lost.newton_iterations);
+  // The hinted path's fate at this bifurcation depends on round-off, and so on the kernels
+  // OpenBLAS picks for the CPU (PETSc's vector norms and dots; core::numerics_platform): with its
+  // SkylakeX kernels the path is lost, with its Haswell / Zen ones (an AMD EPYC, 2026-11-28) a
+  // branch switch reaches the target on it. Where it is lost, the retry must have solved it.
+  if (lost.converged) {
+    WARN("the hinted path reached the target on this platform (" << core::numerics_platform()
+                                                                 << "): the retry from rest is not exercised");
+    CHECK(r.newton_iterations == lost.newton_iterations);  // no retry where nothing was lost
+  } else {
+    CHECK(r.reason.rfind("target reached from rest without the first-increment hint (first try: ", 0) == 0);
+    CHECK(r.newton_iterations > lost.newton_iterations);  // the failed try counts, as recovery
+    CHECK(r.recovery_iterations >= lost.newton_iterations);
+  }
   hstest::check_stable_on_target(*c.sp.problem, with.solution(), r, c.loads[47].target, c.cfg.solver);
   // Load 48 after either: the same first increment, the same numbers.
   const auto next_without = replay(c, without, 48, 48);
