@@ -431,7 +431,7 @@ TEST_CASE("The blocked LDL^T (2x2 nodes, AMD ordering) solves as MUMPS does and 
       } else {
         // Indefinite: the refinement's GMRES (preconditioned by a factor that lost digits to a
         // small pivot) recovers them with OpenBLAS's SkylakeX kernels, and stagnates at P2, shift
-        // 0.2, at 2e-3 - 7e-2 with its Haswell / Zen / Sandybridge ones (measured 2026-11-28 with
+        // 0.2, at 0.07 with its Haswell / Zen / Sandybridge ones (measured 2026-11-28 with
         // OPENBLAS_CORETYPE; 100 iterations or modified Gram-Schmidt did not help). A known
         // weakness of the unpivoted factor, reported here rather than failed: Newton judges every
         // step by its true residual, and the inertia (checked above) is exact either way.

@@ -110,7 +110,7 @@ class LdltFactor {
   std::vector<std::uint32_t> source_, target_;
   core::VecH xp_, yp_, rp_;  ///< b, x and the residual in the new ordering
   core::VecH xp2_, yp2_;     ///< solve_pair's second b and x in the new ordering
-  AlignedDoubles pair_;  ///< solve_pair's right-hand sides, interleaved by node (by cache line, as the factor)
+  AlignedDoubles pair_;  ///< solve_pair's right-hand sides, interleaved by node (on cache lines)
   core::KSPH refine_;
   std::unique_ptr<SingleFactor> single_;  ///< the single kind (then F_ and ksp_ are unused)
 };
