@@ -14,18 +14,15 @@
 #include <vector>
 
 #include "aabb.hpp"
+#include "hypershape/core/vec3.hpp"
 
 namespace hypershape::geometry {
 namespace {
 
-using Vec = std::array<double, 3>;
+using Vec = core::Vec3;
+using core::cross, core::dot, core::sub;
 
-Vec sub(const Vec& a, const Vec& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-double dot(const Vec& a, const Vec& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 double norm2(const Vec& a) { return dot(a, a); }
-Vec cross(const Vec& a, const Vec& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
 Vec midpoint(const Vec& a, const Vec& b) {
   return {0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), 0.5 * (a[2] + b[2])};
 }

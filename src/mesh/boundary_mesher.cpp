@@ -15,6 +15,7 @@
 #include <unordered_map>
 #include <utility>
 
+#include "hypershape/core/vec3.hpp"
 #include "hypershape/mesh/gmsh_mesher.hpp"
 #include "hypershape/mesh/quality.hpp"
 #include "gmsh_util.hpp"
@@ -539,17 +540,12 @@ MeshData run_gmsh(const Boundary& b, const BoundaryMeshOptions& opt, const Grade
 
 // ---- sliver removal (3D) -------------------------------------------------------------------
 
-using Vec3 = std::array<double, 3>;
+using core::cross, core::dot, core::sub, core::Vec3;
 
 Vec3 vertex(const MeshData& m, int v) {
   return {m.coords[std::size_t(v) * 3], m.coords[std::size_t(v) * 3 + 1],
           m.coords[std::size_t(v) * 3 + 2]};
 }
-Vec3 sub(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-Vec3 cross(const Vec3& a, const Vec3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 /// (x1 - x0) . ((x2 - x0) x (x3 - x0)): positive for gmsh's orientation.
 double triple(const MeshData& m, int v0, int v1, int v2, int v3) {

@@ -58,7 +58,6 @@ std::vector<double> grid_points(int dim, int n) {
   return x;
 }
 
-std::string fmt_count(double v) { return std::isfinite(v) ? fmt::format("{:.0f}", v) : "-"; }
 
 /// "N attempts: stage k, ... (first: reason)" from make_shape's failure message, whose lines
 /// after the first read "  attempt A (stage): reason".
@@ -223,8 +222,8 @@ void print_table(std::ostream& os, const std::vector<PresetRecord>& recs) {
                       r.name, r.dim, r.repeats, n_failed, format_seconds(med(s, "draw")),
                       format_seconds(med(s, "mesh")), format_seconds(med(s, "metrics")),
                       format_seconds(med(s, "sdf_grid")), format_seconds(med(s, "patch_grid")),
-                      format_seconds(med(s, "total")), fmt_count(med(v, "boundary_facets")),
-                      fmt_count(med(v, "vertices")), fmt_count(med(v, "cells")), fmt_count(med(v, "redraws")));
+                      format_seconds(med(s, "total")), format_count(med(v, "boundary_facets")),
+                      format_count(med(v, "vertices")), format_count(med(v, "cells")), format_count(med(v, "redraws")));
   }
 }
 

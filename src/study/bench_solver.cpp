@@ -64,9 +64,6 @@ bool varies(const CaseRecord& c, const std::string& k) {
 }
 
 std::string fmt_ratio(double r) { return std::isfinite(r) ? fmt::format("{:.1f}x", r) : "-"; }
-std::string fmt_count(double v) {
-  return std::isfinite(v) ? fmt::format("{}", static_cast<long long>(std::llround(v))) : "-";
-}
 
 /// Relative difference ||a - b|| / ||a|| of two vectors.
 double rel_diff(Vec a, Vec b) {
@@ -347,15 +344,15 @@ void print_sizes_table(std::ostream& os, const std::vector<CaseRecord>& recs) {
     os << fmt::format(
         "{:>3} {:>2} {:>6} {:>7} {:>8} {:>8} {:>8} | {:>5} {:>6} {:>10.4g} {:>8} | {:>9} {:>9} | "
         "{:>13} {:>9} | {:>9} {:>8}\n",
-        s.dim, s.degree, s.h, fmt_count(last(c, "vertices")), fmt_count(last(c, "free_dofs")),
-        format_seconds(med(c, "mesh")), format_seconds(med(c, "setup")), fmt_count(last(c, "full_newton")),
-        fmt_count(last(c, "full_increments")) + "/" + fmt_count(last(c, "full_failed_increments")),
+        s.dim, s.degree, s.h, format_count(last(c, "vertices")), format_count(last(c, "free_dofs")),
+        format_seconds(med(c, "mesh")), format_seconds(med(c, "setup")), format_count(last(c, "full_newton")),
+        format_count(last(c, "full_increments")) + "/" + format_count(last(c, "full_failed_increments")),
         last(c, "alpha"), format_seconds(med(c, "full_solve")),
         format_seconds(derived_value(d, "kernel_sum_full_solve")), fmt_ratio(derived_value(d, "full_solve_overhead")),
         format_seconds(med(c, "target_solve")),
-        fmt_count(last(c, "target_solves")) + "/" + fmt_count(last(c, "target_newton")),
+        format_count(last(c, "target_solves")) + "/" + format_count(last(c, "target_newton")),
         format_seconds(med(c, "second_load")),
-        fmt_count(last(c, "second_solves")) + "/" + fmt_count(last(c, "second_newton")));
+        format_count(last(c, "second_solves")) + "/" + format_count(last(c, "second_newton")));
   }
 }
 
@@ -472,8 +469,8 @@ CaseRecord run_case(const SolverBenchOptions& set, const CaseSpec& cs) {
     }
     if (core::rank(PETSC_COMM_WORLD) == 0)
       std::cerr << fmt::format("[bench] {}D P{} h={} repeat {}/{}: {} DoFs, alpha {:.5g}, {} its, {:.1f}s so far\n",
-                               cs.dim, cs.degree, cs.h, r + 1, set.repeats, fmt_count(last(rec, "free_dofs")),
-                               last(rec, "alpha"), fmt_count(last(rec, "full_newton")),
+                               cs.dim, cs.degree, cs.h, r + 1, set.repeats, format_count(last(rec, "free_dofs")),
+                               last(rec, "alpha"), format_count(last(rec, "full_newton")),
                                core::now_seconds() - t_case);
   }
   add_checks(rec);

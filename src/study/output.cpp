@@ -60,4 +60,8 @@ std::string format_seconds(double s) {
   return fmt::format("{:.0f}s", s);
 }
 
+std::string format_count(double v) {
+  return std::isfinite(v) ? fmt::format("{}", static_cast<long long>(std::llround(v))) : "-";
+}
+
 }  // namespace hypershape::study

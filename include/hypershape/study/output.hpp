@@ -36,5 +36,8 @@ void write_json_atomic(const std::string& path, const nlohmann::json& j, const s
 
 /// Seconds as the benchmark tables print them: "12us", "3.4ms", "1.23s", "123s"; "-" if not finite.
 std::string format_seconds(double s);
+/// A count (or a median of counts) rounded to the nearest integer, halves away from zero; "-" if
+/// not finite.
+std::string format_count(double v);
 
 }  // namespace hypershape::study
