@@ -67,7 +67,12 @@ import os
 import sys
 
 import numpy as np
-import torch
+
+try:
+    import torch
+except ImportError as ex:  # scripts/run.sh installs only what a build and the readers need
+    raise ImportError("hypershape_torch needs PyTorch: apt-get install python3-torch "
+                      "(or scripts/setup.sh without arguments, as scripts/test.sh runs it)") from ex
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import hypershape_data as hd  # noqa: E402
