@@ -10,6 +10,8 @@
 
 using namespace hypershape;
 
+// Named for the unity build (HS_UNITY_BUILD): files of one batch share a scope.
+namespace test_dataset_identity {
 namespace {
 
 const char* base = R"(preset: random2d
@@ -103,3 +105,5 @@ TEST_CASE("YAML that yaml-cpp accepts silently is an input error naming the key"
   CHECK(error_of("preset: random2d\nname: 'it''s'\nseed: 1\nshapes: {count: 2}\n").find("quoted") ==
         std::string::npos);
 }
+
+}  // namespace test_dataset_identity

@@ -14,6 +14,8 @@
 
 using namespace hypershape;
 
+// Named for the unity build (HS_UNITY_BUILD): files of one batch share a scope.
+namespace test_presets {
 namespace {
 
 config::DatasetConfig by_name(const std::string& text) {
@@ -159,3 +161,5 @@ TEST_CASE("random3d labels with the mean dilatation; material.dilatation is the 
   CHECK_THAT(error_of("preset: random2d\nmaterial: {dilatation: avg}\n"),
              Catch::StartsWith("material.dilatation") && Catch::Contains("pointwise, mean"));
 }
+
+}  // namespace test_presets

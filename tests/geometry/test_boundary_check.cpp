@@ -12,6 +12,8 @@
 using namespace hypershape::geometry;
 using Catch::Contains;
 
+// Named for the unity build (HS_UNITY_BUILD): files of one batch share a scope.
+namespace test_boundary_check {
 namespace {
 
 /// The unit icosphere of tests/geometry/shapes.hpp (20 * 4^level outward triangles), shifted.
@@ -223,3 +225,5 @@ TEST_CASE("check_boundary on 82k triangles is fast", "[geometry]") {
   CHECK(r.ok);
   CHECK(seconds < 2.0);
 }
+
+}  // namespace test_boundary_check

@@ -16,6 +16,7 @@
 #include "hypershape/mesh/boundary_mesher.hpp"
 #include "hypershape/mesh/gmsh_mesher.hpp"
 #include "hypershape/mesh/quality.hpp"
+#include "support/helpers.hpp"
 
 using namespace hypershape;
 
@@ -182,9 +183,6 @@ std::set<std::pair<int, int>> cell_edges(const mesh::MeshData& m) {
   return e;
 }
 
-bool same(const mesh::MeshData& a, const mesh::MeshData& b) {
-  return a.dim == b.dim && a.cells == b.cells && a.coords == b.coords;
-}
 
 /// What every mesh of a boundary must satisfy: boundary points first at their exact coordinates,
 /// the boundary facets exactly the input's, the exact measure, no orphan or inverted cell, and
@@ -259,7 +257,7 @@ TEST_CASE("a star polygon meshes to exactly its boundary", "[mesh][boundary_mesh
   SECTION("deterministic") {
     (void)mesh::mesh_boundary(star(300, 0.8, 0.1, 3), opt);  // something else in between
     (void)mesh::mesh_disk(mesh::MeshOptions{}, std::nullopt);
-    CHECK(same(m, mesh::mesh_boundary(b, opt)));
+    CHECK(hstest::same_mesh(m, mesh::mesh_boundary(b, opt)));
   }
 }
 
@@ -355,7 +353,7 @@ TEST_CASE("a closed surface is filled with tetrahedra without remeshing it",
     CHECK(p99 < 1.4);
     CHECK(lengths.back() < 1.75);
   }
-  CHECK(same(m, mesh::mesh_boundary(b, opt)));
+  CHECK(hstest::same_mesh(m, mesh::mesh_boundary(b, opt)));
 }
 
 TEST_CASE("mesh_boundary rejects malformed input", "[mesh][boundary_mesh]") {

@@ -8,14 +8,6 @@
 
 using namespace hypershape;
 
-namespace {
-
-bool same(const mesh::MeshData& a, const mesh::MeshData& b) {
-  return a.dim == b.dim && a.cells == b.cells && a.coords == b.coords;
-}
-
-}  // namespace
-
 TEST_CASE("2D meshes are deterministic", "[mesh][determinism]") {
   mesh::MeshOptions mo;
   mo.h = 0.1;
@@ -25,8 +17,8 @@ TEST_CASE("2D meshes are deterministic", "[mesh][determinism]") {
   (void)mesh::mesh_box(2, 1.0, 0.13);  // something else in between
   const auto d2 = mesh::mesh_disk(mo, clamp);
   CHECK(d1.n_cells() > 100);
-  CHECK(same(d1, d2));
-  CHECK(same(mesh::mesh_box(2, 1.0, 0.1), mesh::mesh_box(2, 1.0, 0.1)));
+  CHECK(hstest::same_mesh(d1, d2));
+  CHECK(hstest::same_mesh(mesh::mesh_box(2, 1.0, 0.1), mesh::mesh_box(2, 1.0, 0.1)));
 }
 
 TEST_CASE("3D meshes are deterministic", "[mesh][determinism]") {
@@ -36,9 +28,9 @@ TEST_CASE("3D meshes are deterministic", "[mesh][determinism]") {
   for (int repeat = 0; repeat < 3; ++repeat) {
     const auto b1 = mesh::mesh_box(3, 1.0, 0.25), b2 = mesh::mesh_box(3, 1.0, 0.25);
     INFO("box cells " << b1.n_cells() << " vs " << b2.n_cells());
-    CHECK(same(b1, b2));
+    CHECK(hstest::same_mesh(b1, b2));
     const auto s1 = mesh::mesh_ball(mo, clamp), s2 = mesh::mesh_ball(mo, clamp);
     INFO("ball cells " << s1.n_cells() << " vs " << s2.n_cells());
-    CHECK(same(s1, s2));
+    CHECK(hstest::same_mesh(s1, s2));
   }
 }

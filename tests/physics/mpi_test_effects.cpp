@@ -11,14 +11,13 @@
 
 using namespace hypershape;
 
+// Named for the unity build (HS_UNITY_BUILD): files of one batch share a scope.
+namespace mpi_test_effects {
 namespace {
 
 using Effects = std::function<std::vector<physics::EffectPtr>()>;
 
-double broadcast(double v) {
-  MPI_Bcast(&v, 1, MPI_DOUBLE, 0, PETSC_COMM_WORLD);
-  return v;
-}
+using hstest::broadcast;
 
 /// The clamped disk with the given material and loads, solved at load factor `alpha`.
 std::vector<double> solve(MPI_Comm comm, const Effects& effects, double alpha, bool& converged, int degree = 1) {
@@ -142,3 +141,5 @@ TEST_CASE("A follower pressure's displacement-controlled path is the same on any
   CHECK(rel < 1e-9);
   CHECK(std::abs(alpha / broadcast(alpha_ref) - 1) < 1e-9);
 }
+
+}  // namespace mpi_test_effects

@@ -14,6 +14,8 @@
 using namespace hypershape;
 using hstest::on_plane;
 
+// Named for the unity build (HS_UNITY_BUILD): files of one batch share a scope.
+namespace test_homogeneous {
 namespace {
 
 /// Principal first Piola stress P_i at principal stretches l (3 of them), material constants
@@ -162,3 +164,5 @@ TEST_CASE("Uniaxial dead traction gives the closed-form homogeneous deformation"
           }
         }
 }
+
+}  // namespace test_homogeneous

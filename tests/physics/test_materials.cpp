@@ -20,6 +20,8 @@
 using namespace hypershape;
 using namespace hypershape::physics;
 
+// Named for the unity build (HS_UNITY_BUILD): files of one batch share a scope.
+namespace test_materials {
 namespace {
 
 constexpr double E = 500.0, NU = 0.3;
@@ -445,3 +447,5 @@ TEST_CASE("Mean dilatation with a pointwise share: the blend of the two material
   CHECK(hstest::rel_diff(r, rm) < 1e-12);
   CHECK(hstest::rel_diff(r, rp) > 1e-4);  // and it is neither of them
 }
+
+}  // namespace test_materials

@@ -13,6 +13,8 @@
 
 using namespace hypershape;
 
+// Named for the unity build (HS_UNITY_BUILD): files of one batch share a scope.
+namespace test_mms {
 namespace {
 
 constexpr double pi = std::numbers::pi;
@@ -207,3 +209,5 @@ TEST_CASE("MMS 3D P2 converges at order 3 when nearly incompressible", "[mms][mm
 TEST_CASE("MMS 3D P1 converges at order 2 on finer meshes", "[mms][mms3d][slow]") {
   check_rates<3>(1, {1.0 / 8, 1.0 / 16, 1.0 / 32}, 1.8);
 }
+
+}  // namespace test_mms

@@ -9,6 +9,8 @@
 
 using namespace hypershape::physics;
 
+// Named for the unity build (HS_UNITY_BUILD): files of one batch share a scope.
+namespace test_neo_hookean {
 namespace {
 
 constexpr double E = 500.0, NU = 0.3;
@@ -194,3 +196,5 @@ TEST_CASE("Neo-Hookean refuses det F <= 0", "[kernel]") {
   SECTION("2D") { check_guard<2>(); }
   SECTION("3D") { check_guard<3>(); }
 }
+
+}  // namespace test_neo_hookean

@@ -10,16 +10,15 @@
 
 using namespace hypershape;
 
+// Named for the unity build (HS_UNITY_BUILD): files of one batch share a scope.
+namespace mpi_test_ranks {
 namespace {
 
 constexpr double h = 0.08;
 
 int world_rank() { return core::rank(PETSC_COMM_WORLD); }
 
-double broadcast(double v) {
-  MPI_Bcast(&v, 1, MPI_DOUBLE, 0, PETSC_COMM_WORLD);
-  return v;
-}
+using hstest::broadcast;
 
 /// max_i |a_i - b_i| / max_i |b_i| (rank 0's arrays).
 double rel_max_diff(const std::vector<double>& a, const std::vector<double>& b) {
@@ -174,3 +173,5 @@ TEST_CASE("Where a mode lives is the same on any number of ranks", "[mpi]") {
     }
   }
 }
+
+}  // namespace mpi_test_ranks

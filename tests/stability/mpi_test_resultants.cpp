@@ -10,6 +10,8 @@
 
 using namespace hypershape;
 
+// Named for the unity build (HS_UNITY_BUILD): files of one batch share a scope.
+namespace mpi_test_resultants {
 namespace {
 
 using Vec3 = std::array<double, 3>;
@@ -124,3 +126,5 @@ TEST_CASE("Spring forces close the force and moment balance on any number of ran
       CHECK(norm(combine(w.spring_force, -1, self_spring)) <= 1e-8 * F);
     }
 }
+
+}  // namespace mpi_test_resultants

@@ -42,6 +42,17 @@ inline bool bitwise_equal(const std::vector<double>& a, const std::vector<double
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
 }
 
+/// Rank 0's value on every rank of PETSC_COMM_WORLD. Collective.
+inline double broadcast(double v) {
+  MPI_Bcast(&v, 1, MPI_DOUBLE, 0, PETSC_COMM_WORLD);
+  return v;
+}
+
+/// The same mesh: dimension, cells and coordinates bit for bit.
+inline bool same_mesh(const hs::mesh::MeshData& a, const hs::mesh::MeshData& b) {
+  return a.dim == b.dim && a.cells == b.cells && a.coords == b.coords;
+}
+
 inline bool all_finite(const std::vector<double>& a) {
   for (double v : a)
     if (!std::isfinite(v)) return false;
