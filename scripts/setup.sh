@@ -3,7 +3,7 @@
 # builds it (Release) in ./build. Idempotent: a second run with nothing changed takes seconds.
 #   scripts/setup.sh                  # every package + configure + build every target (tests too)
 #   scripts/setup.sh hypershape_cli   # the packages a build and its data readers need, and only
-#                                     # the targets named (scripts/run.sh: the CLI, 2.5 of the 4.5
+#                                     # the targets named (scripts/run.sh: the CLI, about 2 of the 5
 #                                     # minutes of a fresh unity build on 2 cores)
 #   BUILD_DIR=build-dev BUILD_TYPE=Developer scripts/setup.sh
 set -euo pipefail
