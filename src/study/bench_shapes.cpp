@@ -58,7 +58,6 @@ std::vector<double> grid_points(int dim, int n) {
   return x;
 }
 
-
 /// "N attempts: stage k, ... (first: reason)" from make_shape's failure message, whose lines
 /// after the first read "  attempt A (stage): reason".
 std::string summarise_failure(const std::string& what) {

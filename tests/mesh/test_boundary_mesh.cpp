@@ -183,7 +183,6 @@ std::set<std::pair<int, int>> cell_edges(const mesh::MeshData& m) {
   return e;
 }
 
-
 /// What every mesh of a boundary must satisfy: boundary points first at their exact coordinates,
 /// the boundary facets exactly the input's, the exact measure, no orphan or inverted cell, and
 /// the default quality gate.
