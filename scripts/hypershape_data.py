@@ -803,7 +803,8 @@ def check_dataset(path, out=sys.stdout):
 
 
 OUTCOMES = ("path", "branch switch from an unstable state", "branch switch after a stall",
-            "arc-length rescue", "retry from rest", "other", "failed", "failed at a verified fold",
+            "arc-length rescue", "retry from rest", "from the P1 solution", "other", "failed",
+            "failed at a verified fold",
             "shape failed")
 
 
@@ -811,7 +812,8 @@ def load_case_outcome(status, reason):
     """How a load case's solve ended, from its stored status and reason (docs/FORMAT.md): on the
     path itself, after a branch switch from an unstable state on target (a bifurcation or a
     fold) or from a stalled path, by the arc-length rescue, by the retry from rest without the
-    first-increment hint, otherwise converged, or failed: at a verified fold (the path from rest
+    first-increment hint, from the P1 solution on the same mesh (a P2 dataset's last rescue:
+    SolverOptions::p1_start), otherwise converged, or failed: at a verified fold (the path from rest
     passed a limit point of the load, so its state on target is unstable, and no branch switch
     found a stable one: docs/STABILITY.md) or otherwise."""
     if not status:
@@ -826,6 +828,8 @@ def load_case_outcome(status, reason):
         return "arc-length rescue"
     if reason.startswith("target reached from rest without the first-increment hint"):
         return "retry from rest"
+    if reason.startswith("target reached from the P1 solution on the same mesh"):
+        return "from the P1 solution"
     return "other"
 
 

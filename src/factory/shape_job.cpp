@@ -12,6 +12,7 @@
 #include "hypershape/factory/dataset_schema.hpp"
 #include "hypershape/factory/label_error.hpp"
 #include "hypershape/factory/load_cases.hpp"
+#include "hypershape/factory/p1_start.hpp"
 #include "hypershape/factory/shape_pipeline.hpp"
 #include "hypershape/factory/shape_set.hpp"
 #include "hypershape/geometry/distance.hpp"
@@ -401,8 +402,8 @@ struct LoadOutcome {
 };
 
 LoadOutcome solve_load_case(MPI_Comm group, const config::DatasetConfig& cfg, const ShapeSample& shape,
-                            ShapeProblem& sp, solver::NonlinearSolver& nl, const LoadCase& lc, core::PhaseTimes& times,
-                            double& normaliser) {
+                            ShapeProblem& sp, solver::NonlinearSolver& nl, P1Start& p1, const LoadCase& lc,
+                            core::PhaseTimes& times, double& normaliser) {
   LoadOutcome o;
   std::string failure;
   try {
@@ -415,6 +416,12 @@ LoadOutcome solve_load_case(MPI_Comm group, const config::DatasetConfig& cfg, co
     o.result = nl.solve_for_target(lc.target);
     times.add("solve", o.result.seconds_first_solve);
     times.add("alpha_search", o.result.seconds_total - o.result.seconds_first_solve);
+    if (p1.applies(o.result)) {
+      auto t = times.scope("alpha_search");
+      std::string note;
+      if (auto r = p1.solve(lc, nl, o.result, note)) o.result = std::move(*r);
+      else o.result.reason += note;
+    }
   } catch (const std::runtime_error& e) {  // PETSc's and the solver's failures: data
     failure = std::string("error: ") + e.what();
   }  // a std::logic_error is a bug: it ends the run (the shard is redone on resume)
@@ -468,6 +475,7 @@ ShapeSolve solve_shape(MPI_Comm group, const config::DatasetConfig& cfg, const S
     auto t = out.times.scope("representations");
     fields = shape_fields(cfg, shape, sp.problem->space(), moments, arrays);
   }
+  P1Start p1(group, cfg, shape);  // built at the first load case it rescues
   LoadTable table(n_loads, cfg.shapes.dim);
   LoadFields load_fields(*sp.problem, cfg, fields, n_loads);
   DrawnParams drawn(cfg, shape.shape_id, n_loads);
@@ -478,7 +486,7 @@ ShapeSolve solve_shape(MPI_Comm group, const config::DatasetConfig& cfg, const S
     const auto L = std::size_t(l);
     table.set_case(L, cases[L]);
     drawn.add(cases[L]);  // before anything that may fail: one row per load case
-    LoadOutcome o = solve_load_case(group, cfg, shape, sp, *nl, cases[L], out.times, table.normaliser[L]);
+    LoadOutcome o = solve_load_case(group, cfg, shape, sp, *nl, p1, cases[L], out.times, table.normaliser[L]);
     table.set_cost(L, o.result);
     out.counters.add(o.result);
     table.status[L] = o.ok ? 1 : 0;

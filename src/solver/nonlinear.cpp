@@ -237,6 +237,20 @@ TargetResult NonlinearSolver::solve_for_target(double target) {
   return t;
 }
 
+TargetResult NonlinearSolver::solve_for_target_from(Vec u, double load_factor, double target) {
+  const double start = core::now_seconds();
+  const LinearCounters linear_before = linear_counters();
+  const double kept = step_hint_;
+  HS_PETSC(VecCopy(u, u_));
+  s_ = load_factor;
+  TargetResult t = attempt_target(target, start);
+  step_hint_ = kept;
+  t.seconds_total = core::now_seconds() - start;
+  if (t.solves <= 1) t.seconds_first_solve = t.seconds_total;
+  t.linear = linear_counters() - linear_before;
+  return t;
+}
+
 TargetResult NonlinearSolver::attempt_target(double target, double start) {
   known_internal_ = NAN;  // the problem may have changed since (effects switched, a new load)
   TargetResult t = opt_.control == Control::displacement ? follow_path(target, start)

@@ -387,6 +387,8 @@ def solver_outcomes(path):
             "arc-length rescue",
         (1, "target reached from rest without the first-increment hint (first try: Newton budget of 200 "
             "iterations spent)"): "retry from rest",
+        (1, "target reached from the P1 solution on the same mesh (target reached after a branch switch "
+            "(...); first try: ...)"): "from the P1 solution",
         (1, "target reached by load control (displacement control: ...)"): "other",
         (0, "target reached"): "failed",
         (0, "fold: max|u| = target lies on an unstable segment of the path (at max|u| = 0.46, ...)"):
@@ -397,9 +399,11 @@ def solver_outcomes(path):
     check(got == reasons, f"load_case_outcome classes the solver's reasons: {got}")
     cpp = "".join(open(os.path.join(src, "src", "solver", f)).read()
                   for f in ("branch_switch.cpp", "path_following.cpp", "nonlinear.cpp"))
+    cpp += open(os.path.join(src, "src", "factory", "p1_start.cpp")).read()
     written = ['"target reached after a branch switch ("', '"loss of stability at max|u| = "',
                '"fold: max|u| = target lies on an unstable segment', '"target reached by arc-length continuation',
-               '"target reached from rest without the first-increment hint', '"target reached"']
+               '"target reached from rest without the first-increment hint', '"target reached"',
+               '"target reached from the P1 solution on the same mesh']
     check(all(w in cpp for w in written), "the reasons load_case_outcome reads are the ones src/solver writes")
     out = subprocess.run([sys.executable, script, "solver", path], capture_output=True, text=True).stdout
     check("by outcome (load cases, Newton iterations each): path " in out, "`solver` prints the split by outcome")

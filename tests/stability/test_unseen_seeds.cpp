@@ -9,6 +9,7 @@
 
 #include <cstdlib>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -19,6 +20,7 @@
 #include "hypershape/factory/accuracy.hpp"
 #include "hypershape/factory/dataset_scene.hpp"
 #include "hypershape/factory/load_cases.hpp"
+#include "hypershape/factory/p1_start.hpp"
 #include "hypershape/factory/shape_pipeline.hpp"
 #include "hypershape/solver/nonlinear.hpp"
 #include "hypershape/solver/error_estimate.hpp"
@@ -360,4 +362,52 @@ TEST_CASE("The arc-length rescue ends stable on target where the path and its br
     CHECK((r.reason.find("arc-length continuation") != std::string::npos) == rescued);
     hstest::check_stable_on_target(*c.sp.problem, ns.solution(), r, target, opt);
   }
+}
+
+namespace {
+
+/// Load case `load` of `c` (a P2 config) solved alone; where that fails, the factory's rescue from
+/// the P1 solution on the same mesh (factory::P1Start). Prints both; returns the rescue's outcome.
+std::optional<solver::TargetResult> from_p1(Case& c, solver::NonlinearSolver& ns, int load) {
+  const auto& lc = c.set(load);
+  const auto failed = ns.solve_for_target(lc.target);
+  std::cout << "seed " << c.cfg.seed << " shape " << c.shape.shape_id << " load " << load << " alone: "
+            << (failed.converged ? "ok" : "FAILED") << ", " << failed.newton_iterations << " its: " << failed.reason << "\n";
+  factory::P1Start p1(PETSC_COMM_WORLD, c.cfg, c.shape);
+  if (!p1.applies(failed)) return std::nullopt;
+  std::string note;
+  auto r = p1.solve(lc, ns, failed, note);
+  std::cout << "  from P1: " << (r ? (r->converged ? "ok" : "FAILED") : "P1 failed") << ", "
+            << (r ? r->newton_iterations : 0) << " its: " << (r ? r->reason : note) << "\n";
+  return r;
+}
+
+}  // namespace
+
+TEST_CASE("A P2 load case lost on every path from rest is reached from the P1 solution on the same mesh",
+          "[stability][branch]") {
+  // Seed 12345 (no run had used it before 2026-11-28), shape 19, load 5: lost by the factory (the
+  // hinted path, its switches and the retry from rest; docs/STABILITY.md) and alone (the path from
+  // rest and its switches: "no progress in 4 Newton iterations", the budget spent). P1 on the same
+  // mesh converges (alpha 54.4; P2's own path had reached 36.2); from its state the P2 path and a
+  // branch switch end on a verified stable equilibrium on target (alpha 42.3).
+  Case c(12345, 19, HS_SOURCE_DIR "/configs/presets/random2d.yaml");
+  solver::NonlinearSolver ns(*c.sp.problem, c.cfg.solver);
+  const auto r = from_p1(c, ns, 5);
+  REQUIRE(r);  // it failed alone (the case the rescue is for) and P1 converged
+  CHECK(r->reason.rfind("target reached from the P1 solution on the same mesh", 0) == 0);
+  hstest::check_stable_on_target(*c.sp.problem, ns.solution(), *r, c.loads[5].target, c.cfg.solver);
+}
+
+/// A failed load case alone and from the P1 solution on the same mesh, as the factory rescues it:
+///   CONFIG=configs/presets/random2d.yaml SEED=12345 SHAPE=5 LOAD=0 unit_tests "[p1_start]"
+TEST_CASE("Replay a failed load case from the P1 solution on the same mesh", "[.][p1_start]") {
+  const char* config = std::getenv("CONFIG");
+  Case c(std::uint64_t(env_int("SEED", 12345)), env_int("SHAPE", 19),
+         config ? config : HS_SOURCE_DIR "/configs/presets/random2d.yaml");
+  solver::NonlinearSolver ns(*c.sp.problem, c.cfg.solver);
+  const int load = env_int("LOAD", 5);
+  REQUIRE(std::size_t(load) < c.loads.size());
+  const auto r = from_p1(c, ns, load);
+  if (r && r->converged) hstest::check_stable_on_target(*c.sp.problem, ns.solution(), *r, c.loads[std::size_t(load)].target, c.cfg.solver);
 }

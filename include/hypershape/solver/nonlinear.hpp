@@ -121,6 +121,10 @@ struct SolverOptions {
   /// The next load case's hint stays the one the first try left, so load cases that converged
   /// are unchanged bit for bit (docs/SOLVER.md, "a retry from rest").
   bool retry_from_rest = true;
+  /// The data factory, 2D P2 only: a load case that failed after all of the above (not at a
+  /// verified fold) is solved with P1 elements on the same mesh, and the P2 path taken once more
+  /// from that state (factory/p1_start.hpp). Only load cases that failed change.
+  bool p1_start = true;
   /// The displacement-controlled path's linear solves: Newton-Krylov on a kept factorisation
   /// (default) or a fresh factorisation per Newton iteration (tangent.reuse = false).
   TangentOptions tangent;
@@ -200,6 +204,11 @@ class NonlinearSolver {
   double load_factor() const { return s_; }
   /// Back to u = 0 at load factor 0.
   void reset();
+  /// solve_for_target() from the state u (a global vector of the problem, e.g. another
+  /// discretisation's solution) at load factor s instead of from rest: the path continues from
+  /// there, then the branch switches as after any path (no retry from rest). The next load
+  /// case's first-increment hint is left as it was. Collective.
+  TargetResult solve_for_target_from(Vec u, double load_factor, double target);
   /// Solves R(u) = f_int(u) - s f_ext = 0 at load factor `s`, continuing from the current state.
   SolveResult solve(double load_factor);
   /// Finds alpha with |max|u| / target - 1| <= target_rtol, reusing the state, matrix and
