@@ -208,6 +208,13 @@ bool verified_fold(const std::string& reason) { return reason.rfind("fold:", 0) 
 
 }  // namespace
 
+TargetResult NonlinearSolver::timed(TargetResult t, double start, const LinearCounters& linear_before) const {
+  t.seconds_total = core::now_seconds() - start;
+  if (t.solves <= 1) t.seconds_first_solve = t.seconds_total;
+  t.linear = linear_counters() - linear_before;
+  return t;
+}
+
 TargetResult NonlinearSolver::solve_for_target(double target) {
   const double start = core::now_seconds();
   const LinearCounters linear_before = linear_counters();
@@ -231,10 +238,7 @@ TargetResult NonlinearSolver::solve_for_target(double target) {
                                  t.reason.substr(0, 400);
     step_hint_ = kept;  // the next load case's hint as the first try left it
   }
-  t.seconds_total = core::now_seconds() - start;
-  if (t.solves <= 1) t.seconds_first_solve = t.seconds_total;
-  t.linear = linear_counters() - linear_before;
-  return t;
+  return timed(t, start, linear_before);
 }
 
 TargetResult NonlinearSolver::solve_for_target_from(Vec u, double load_factor, double target) {
@@ -245,10 +249,7 @@ TargetResult NonlinearSolver::solve_for_target_from(Vec u, double load_factor, d
   s_ = load_factor;
   TargetResult t = attempt_target(target, start);
   step_hint_ = kept;
-  t.seconds_total = core::now_seconds() - start;
-  if (t.solves <= 1) t.seconds_first_solve = t.seconds_total;
-  t.linear = linear_counters() - linear_before;
-  return t;
+  return timed(t, start, linear_before);
 }
 
 TargetResult NonlinearSolver::attempt_target(double target, double start) {

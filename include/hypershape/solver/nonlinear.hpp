@@ -237,6 +237,8 @@ class NonlinearSolver {
   struct LoadExtremes;  ///< the load's extremes along a path (path_following.cpp)
 
  private:
+  /// t with its seconds (from `start`) and the linear solver's counts since `linear_before`.
+  TargetResult timed(TargetResult t, double start, const LinearCounters& linear_before) const;
   static PetscErrorCode form_function(SNES, Vec, Vec, void*);
   static PetscErrorCode form_jacobian(SNES, Vec, Mat, Mat, void*);
   static PetscErrorCode form_objective(SNES, Vec, PetscReal*, void*);
