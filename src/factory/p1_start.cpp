@@ -89,7 +89,9 @@ std::optional<solver::TargetResult> P1Start::solve(const LoadCase& lc, solver::N
   t.add_earlier(failed, true);
   t.newton_iterations += p1.newton_iterations;  // P1's, discarded work too (each a quarter of a P2 one's cost)
   t.recovery_iterations += p1.newton_iterations;
+  t.linear += failed.linear;  // (add_earlier counts iterations; the factorisations of all three solves)
   t.linear += p1.linear;
+  t.seconds_total += failed.seconds_total + p1.seconds_total;
   t.reason = t.converged ? "target reached from the P1 solution on the same mesh (" + t.reason.substr(0, 200) +
                                "; first try: " + failed.reason.substr(0, 300) + ")"
                          : failed.reason.substr(0, 400) + "; from the P1 solution on the same mesh: " +

@@ -7,6 +7,7 @@
 /// SEED=2024 SHAPE=12 LOAD=17 FROM=17, with that solver: FAILED, 200 its).
 #include <catch2/catch.hpp>
 
+#include <cstdint>
 #include <cstdlib>
 #include <iostream>
 #include <optional>
@@ -366,11 +367,14 @@ TEST_CASE("The arc-length rescue ends stable on target where the path and its br
 
 namespace {
 
+std::int64_t factorisations_before_rescue = 0;  ///< from_p1's failed solve's (the rescue adds its own)
+
 /// Load case `load` of `c` (a P2 config) solved alone; where that fails, the factory's rescue from
 /// the P1 solution on the same mesh (factory::P1Start). Prints both; returns the rescue's outcome.
 std::optional<solver::TargetResult> from_p1(Case& c, solver::NonlinearSolver& ns, int load) {
   const auto& lc = c.set(load);
   const auto failed = ns.solve_for_target(lc.target);
+  factorisations_before_rescue = failed.linear.numeric_factorizations;
   std::cout << "seed " << c.cfg.seed << " shape " << c.shape.shape_id << " load " << load << " alone: "
             << (failed.converged ? "ok" : "FAILED") << ", " << failed.newton_iterations << " its: " << failed.reason << "\n";
   factory::P1Start p1(PETSC_COMM_WORLD, c.cfg, c.shape);
@@ -396,6 +400,8 @@ TEST_CASE("A P2 load case lost on every path from rest is reached from the P1 so
   const auto r = from_p1(c, ns, 5);
   REQUIRE(r);  // it failed alone (the case the rescue is for) and P1 converged
   CHECK(r->reason.rfind("target reached from the P1 solution on the same mesh", 0) == 0);
+  // Its counts add up the failed try's, P1's and the new P2 path's (the run report's totals).
+  CHECK(r->linear.numeric_factorizations > factorisations_before_rescue + 20);
   hstest::check_stable_on_target(*c.sp.problem, ns.solution(), *r, c.loads[5].target, c.cfg.solver);
 }
 
