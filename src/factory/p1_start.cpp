@@ -68,7 +68,7 @@ bool P1Start::applies(const solver::TargetResult& failed) const {
   // 2D only: measured there (docs/SOLVER.md); the 3D presets lose too few load cases (1 of 200
   // on an unseen seed) to measure it on.
   return cfg_.solver.p1_start && cfg_.degree == 2 && cfg_.shapes.dim == 2 && !failed.converged && failed.solves > 0 &&
-         failed.reason.rfind("fold:", 0) != 0;  // a verified fold: no stable state on the path
+         !solver::verified_fold(failed.reason);
 }
 
 std::optional<solver::TargetResult> P1Start::solve(const LoadCase& lc, solver::NonlinearSolver& p2,

@@ -419,8 +419,12 @@ LoadOutcome solve_load_case(MPI_Comm group, const config::DatasetConfig& cfg, co
     if (p1.applies(o.result)) {
       auto t = times.scope("alpha_search");
       std::string note;
-      if (auto r = p1.solve(lc, nl, o.result, note)) o.result = std::move(*r);
-      else o.result.reason += note;
+      try {  // the rescue's own failure leaves the load case's failure and its reason standing
+        if (auto r = p1.solve(lc, nl, o.result, note)) o.result = std::move(*r);
+      } catch (const std::runtime_error& e) {
+        note = std::string("; P1 start: error: ") + e.what();
+      }
+      if (!note.empty()) o.result.reason += note;
     }
   } catch (const std::runtime_error& e) {  // PETSc's and the solver's failures: data
     failure = std::string("error: ") + e.what();

@@ -199,14 +199,7 @@ bool NonlinearSolver::residual_at(Vec X, double s, Vec r) {
   return true;
 }
 
-namespace {
-
-/// Whether a failed path's reason is a verified fold (follow_path: the state on target is on
-/// an unstable segment between limit points of the load), which neither the arc-length rescue
-/// nor a retry from rest gets past.
 bool verified_fold(const std::string& reason) { return reason.rfind("fold:", 0) == 0; }
-
-}  // namespace
 
 TargetResult NonlinearSolver::timed(TargetResult t, double start, const LinearCounters& linear_before) const {
   t.seconds_total = core::now_seconds() - start;

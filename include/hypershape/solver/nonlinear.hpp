@@ -191,6 +191,11 @@ struct ModeExtent {
 };
 ModeExtent mode_extent(const physics::Problem& problem, Vec v);
 
+/// Whether a failed target solve's reason is a verified fold (follow_path: the state on target
+/// is on an unstable segment between limit points of the load), which neither the arc-length
+/// rescue, a retry from rest nor a start from another discretisation's state gets past.
+bool verified_fold(const std::string& reason);
+
 class NonlinearSolver {
  public:
   /// Collective over the problem's communicator; reads PETSc options with `prefix`.
