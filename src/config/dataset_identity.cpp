@@ -56,6 +56,7 @@ std::string solver_text(const solver::SolverOptions& s) {
          (s.arc_length_rescue ? "  arc_length_rescue: true\n" : "") +  // only when turned on (the default since 2026-11-28)
          (s.retry_from_rest ? "" : "  retry_from_rest: false\n") +
          (s.p1_start ? "" : "  p1_start: false\n") +  // the default (2026-11-29): older identities unchanged
+         (s.predictor == solver::Predictor::second_order ? "" : "  predictor: tangent\n") +  // likewise
          (s.tangent.single_factor ? "  factor_precision: single\n" : "");
 }
 

@@ -285,14 +285,60 @@ bool NonlinearSolver::predict(double d_next, std::string& why) {
     return false;
   }
   const double dalpha = (d_next - m) / ca;
-  const double s_pred = s_ + dalpha;
-  if (!residual_at(u_, s_pred, r_)) throw std::logic_error("a converged state is inadmissible");
+  double s_pred = s_ + dalpha;
   HS_PETSC(VecAXPBY(du_, -dalpha, 0.0, a_));  // Y = -dalpha a
+  // With the direct factor a_ was solved with: not with multigrid or a kept factor's Krylov
+  // solves (no factor, or one of another tangent), nor on the arc-length path (another constraint).
+  if (opt_.predictor == Predictor::second_order && !arc_ && !tangent_->multigrid() && !opt_.tangent.reuse &&
+      tangent_->has_factor())
+    second_order_term(dalpha, ca, s_pred);
+  if (!residual_at(u_, s_pred, r_)) throw std::logic_error("a converged state is inadmissible");
   const double lambda = backtrack(u_, du_, r_, s_pred, w_, b_);
   if (lambda > 0.0) {
     accept_trial(w_, u_);
     s_ += lambda * dalpha;
   }
+  return true;
+}
+
+bool NonlinearSolver::second_order_term(double dalpha, double ca, double& s_pred) {
+  // Along the path R(u(alpha), alpha) = F_int(u) - alpha f_ext = 0: K u' = f_ext and
+  // K u'' = -D^2 F_int[u', u']. With v = dalpha u', the symmetric difference
+  //   q = (R(u + v, s + dalpha) + R(u - v, s - dalpha)) / 2 - R(u, s) = D^2 F_int[v, v] / 2 + O(|v|^4)
+  // (the load terms cancel), so u + v - K^-1 q is the path to second order. A nearly
+  // incompressible body's tangent step stretches where it rotates (its volume error grows
+  // with the square of the rotation); the second-order term takes most of that back, so the
+  // corrector starts nearer the path (the disk at P2: a third of the Newton iterations).
+  // Where the term is large against v, the path bends too much over the step for a Taylor
+  // series: the tangent step alone, as before. The ratio: measured on Random2D P2 (seed 2024,
+  // 20 x 25): increments with |K^-1 q| <= 0.05 |v| took 1.6 corrector iterations and none failed,
+  // 0.05-0.1: 2.8 and a tenth failed, above 0.1 mostly failed; Newton iterations per load case
+  // with the term up to 0.05 / 0.1 / 0.15 / 0.3 / always: -6% / -15% / -16% / -12% / -2%.
+  constexpr double kMaxCurvatureRatio = 0.1;
+  if (!curvature_) HS_PETSC(VecDuplicate(u_, curvature_.out()));
+  Vec q = r_, k2 = curvature_;
+  HS_PETSC(VecWAXPY(w_, -1.0, du_, u_));  // u + v
+  if (!problem_.residual(w_, s_ + dalpha, q)) return false;
+  HS_PETSC(VecWAXPY(w_, 1.0, du_, u_));  // u - v
+  if (!problem_.residual(w_, s_ - dalpha, k2)) return false;
+  HS_PETSC(VecAXPBY(q, 0.5, 0.5, k2));
+  if (!residual_at(u_, s_, k2)) return false;
+  HS_PETSC(VecAXPY(q, -1.0, k2));
+  // With the factor a_ was solved with (unrefined where it is single precision: a predictor).
+  if (!tangent_->apply_factor(q, k2, false)) return false;
+  PetscReal nk2, nv;
+  HS_PETSC(VecNorm(k2, NORM_INFINITY, &nk2));
+  HS_PETSC(VecNorm(du_, NORM_INFINITY, &nv));
+  HS_PETSC(PetscInfo(snes_.get(), "second-order term: |K^-1 q| / |v| = %g%s\n", double(nk2 / nv),
+                     nk2 <= kMaxCurvatureRatio * nv ? "" : " (not used)"));
+  if (!(nk2 <= kMaxCurvatureRatio * nv)) return false;
+  // step = v - K^-1 q + dalpha2 a, with dalpha2 such that c . step = dalpha c . a (the increment's
+  // max|u|); du_ = -step.
+  PetscReal ck2;
+  HS_PETSC(VecDot(c_, k2, &ck2));
+  const double dalpha2 = ck2 / ca;
+  HS_PETSC(VecAXPBYPCZ(du_, 1.0, -dalpha2, 1.0, k2, a_));
+  s_pred += dalpha2;
   return true;
 }
 

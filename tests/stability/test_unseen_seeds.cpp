@@ -87,10 +87,14 @@ solver::TargetResult replay(Case& c, solver::NonlinearSolver& ns, int from, int 
 TEST_CASE("Unseen-seed load cases that need a branch switch end stable on target", "[stability][branch]") {
   // (seed, shape, load): 2024/12/17 failed before (see above); 777/3/47 and 31337/7/42 leave a
   // stalled path by a branch switch.
+  // 2024/12/17 on the tangent predictor's path: with the second-order predictor (the default since
+  // 2026-11-29) it is lost alone (the budget spent after two switches) and reached in the
+  // factory's order after a switch (156 Newton iterations), which the next test case checks.
   const std::vector<std::tuple<int, int, int>> cases = {{2024, 12, 17}, {777, 3, 47}, {31337, 7, 42}};
   for (const auto& [seed, shape_id, load_id] : cases) {
     Case c(std::uint64_t(seed), shape_id);
     const auto& lc = c.set(load_id);
+    if (seed == 2024) c.cfg.solver.predictor = solver::Predictor::tangent;
     solver::NonlinearSolver ns(*c.sp.problem, c.cfg.solver);
     const auto r = ns.solve_for_target(lc.target);
     std::cout << "seed " << seed << " shape " << shape_id << " load " << load_id << ": " << r.reason << " ("
@@ -99,6 +103,17 @@ TEST_CASE("Unseen-seed load cases that need a branch switch end stable on target
     CHECK(r.reason.find("branch switch") != std::string::npos);  // the case exercises the switch
     hstest::check_stable_on_target(*c.sp.problem, ns.solution(), r, lc.target, c.cfg.solver);
   }
+}
+
+TEST_CASE("2024/12/17 in the factory's order ends stable on target after a branch switch", "[stability][branch]") {
+  // With the second-order predictor (the default): the factory's order (loads 0-17 of shape 12,
+  // each path's first increment the previous one's) reaches it after a branch switch.
+  Case c(2024, 12);
+  solver::NonlinearSolver ns(*c.sp.problem, c.cfg.solver);
+  const auto r = replay(c, ns, 0, 17);
+  INFO(r.reason);
+  CHECK(r.reason.find("branch switch") != std::string::npos);
+  hstest::check_stable_on_target(*c.sp.problem, ns.solution(), r, c.loads[17].target, c.cfg.solver);
 }
 
 /// Replays a shape's load cases FROM..LOAD as the factory does (one solver, in order: the first
@@ -355,6 +370,9 @@ TEST_CASE("The arc-length rescue ends stable on target where the path and its br
     const double target = c.loads[std::size_t(load_id)].target;
     solver::SolverOptions opt = c.cfg.solver;
     opt.arc_length_rescue = true;
+    // The cases are the tangent predictor's: with the second-order one (the default since
+    // 2026-11-29) both reach the target without the rescue.
+    opt.predictor = solver::Predictor::tangent;
     opt.step_growth = growth;  // 0: the default
     solver::NonlinearSolver ns(*c.sp.problem, opt);
     const auto r = replay(c, ns, 0, load_id);
@@ -395,7 +413,11 @@ TEST_CASE("A P2 load case lost on every path from rest is reached from the P1 so
   // rest and its switches: "no progress in 4 Newton iterations", the budget spent). P1 on the same
   // mesh converges (alpha 54.4; P2's own path had reached 36.2); from its state the P2 path and a
   // branch switch end on a verified stable equilibrium on target (alpha 42.3).
+  // On the tangent predictor's path: with the second-order one (the default since 2026-11-29)
+  // this load case converges alone (154 Newton iterations, a branch switch), so it would not
+  // exercise the rescue.
   Case c(12345, 19, HS_SOURCE_DIR "/configs/presets/random2d.yaml");
+  c.cfg.solver.predictor = solver::Predictor::tangent;
   solver::NonlinearSolver ns(*c.sp.problem, c.cfg.solver);
   const auto r = from_p1(c, ns, 5);
   REQUIRE(r);  // it failed alone (the case the rescue is for) and P1 converged

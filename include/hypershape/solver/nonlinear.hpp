@@ -81,6 +81,12 @@ enum class Control {
   load,          ///< load-controlled solves at secant-updated alpha (the former default)
 };
 
+/// The displacement-controlled path's predictor (SolverOptions::predictor).
+enum class Predictor {
+  tangent,       ///< the tangent step to the next max|u| (the only one until 2026-11-29)
+  second_order,  ///< the tangent step plus the path's second-order term where it is small
+};
+
 struct SolverOptions {
   double rtol = 1e-9;          ///< converged when ||R|| <= rtol ||alpha f_ext|| (+ atol)
   double atol = 1e-12;
@@ -125,6 +131,12 @@ struct SolverOptions {
   /// verified fold) is solved with P1 elements on the same mesh, and the P2 path taken once more
   /// from that state (factory/p1_start.hpp). Only load cases that failed change.
   bool p1_start = true;
+  /// Displacement control: the increment's predictor. `second_order` (default since 2026-11-29)
+  /// adds the path's second-order term to the tangent step v = dalpha K^-1 f_ext:
+  /// -K^-1 q with q = (R(u + v, s + dalpha) + R(u - v, s - dalpha)) / 2 - R(u, s), two residuals and
+  /// a solve with the factor at hand (NonlinearSolver::second_order_term), where that term is at
+  /// most max_curvature_ratio of v (|.|_inf); `tangent`: the tangent step alone (before).
+  Predictor predictor = Predictor::second_order;
   /// The displacement-controlled path's linear solves: Newton-Krylov on a kept factorisation
   /// (default) or a fresh factorisation per Newton iteration (tangent.reuse = false).
   TangentOptions tangent;
@@ -309,6 +321,11 @@ class NonlinearSolver {
   /// towards max|u| = d_next, damped by the guarded line search. False (`why`) where max|u| does
   /// not respond to the load.
   bool predict(double d_next, std::string& why);
+  /// With the tangent step -du_ = dalpha a_ to c . u = m + dalpha c . a_ from the equilibrium u_
+  /// at s_: adds the path's second-order term to it (keeping c . step) and to `s_pred`, where
+  /// that term is at most kMaxCurvatureRatio of the step (|.|_inf). False (du_, s_pred unchanged)
+  /// where it is larger, or u_ -+ the step is inadmissible.
+  bool second_order_term(double dalpha, double ca, double& s_pred);
   /// The path's result from the state it ended in (`at_target`: its last increment reached
   /// the target): max|u|, alpha, inertia, and the converged state's final check.
   void finish_path(TargetResult& t, bool at_target);
@@ -409,6 +426,7 @@ class NonlinearSolver {
   /// NaN: none).
   double trial_internal_ = NAN, known_internal_ = NAN;
   core::VecH trial_force_, known_force_, known_state_;
+  core::VecH curvature_;  ///< second_order_term's K^-1 q (created at its first use)
   double step_hint_ = 0;
   double s0_ = 0;       ///< load factor of the state a branch switch left (in v0_)
   int negative_pivots_ = -1;  ///< inertia of the last tangent_response() (-1: unknown)
