@@ -105,15 +105,25 @@ TEST_CASE("Unseen-seed load cases that need a branch switch end stable on target
   }
 }
 
+namespace {
+
+/// Replays loads 0..load of `shape_id` of `seed` as the factory solves them (the default solver):
+/// the last must end stable on target after a branch switch.
+void check_switched_in_factory_order(int seed, int shape_id, int load) {
+  Case c(std::uint64_t(seed), shape_id);
+  solver::NonlinearSolver ns(*c.sp.problem, c.cfg.solver);
+  const auto r = replay(c, ns, 0, load);
+  INFO(r.reason);
+  CHECK(r.reason.find("branch switch") != std::string::npos);
+  hstest::check_stable_on_target(*c.sp.problem, ns.solution(), r, c.loads[std::size_t(load)].target, c.cfg.solver);
+}
+
+}  // namespace
+
 TEST_CASE("2024/12/17 in the factory's order ends stable on target after a branch switch", "[stability][branch]") {
   // With the second-order predictor (the default): the factory's order (loads 0-17 of shape 12,
   // each path's first increment the previous one's) reaches it after a branch switch.
-  Case c(2024, 12);
-  solver::NonlinearSolver ns(*c.sp.problem, c.cfg.solver);
-  const auto r = replay(c, ns, 0, 17);
-  INFO(r.reason);
-  CHECK(r.reason.find("branch switch") != std::string::npos);
-  hstest::check_stable_on_target(*c.sp.problem, ns.solution(), r, c.loads[17].target, c.cfg.solver);
+  check_switched_in_factory_order(2024, 12, 17);
 }
 
 /// Replays a shape's load cases FROM..LOAD as the factory does (one solver, in order: the first
@@ -192,12 +202,7 @@ TEST_CASE("A stalled path rescued by a minimisation let finish ends stable on ta
   // Seed 777, shape 7, load 9 (replayed from load 0): the path stalls at max|u| 0.25 (tangent
   // positive definite, steps cut by the line search); the first branch switch's minimisation had
   // |R| 3e-4 (tolerance 4e-9) and falling quadratically when its 48-iteration cap ended it.
-  Case c(777, 7);
-  solver::NonlinearSolver ns(*c.sp.problem, c.cfg.solver);
-  const auto r = replay(c, ns, 0, 9);
-  INFO(r.reason);
-  CHECK(r.reason.find("branch switch") != std::string::npos);
-  hstest::check_stable_on_target(*c.sp.problem, ns.solution(), r, c.loads[9].target, c.cfg.solver);
+  check_switched_in_factory_order(777, 7, 9);
 }
 
 TEST_CASE("A branch switch leaves along the tangent's lowest mode and not the mode nearest zero",

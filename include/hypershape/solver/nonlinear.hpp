@@ -135,7 +135,7 @@ struct SolverOptions {
   /// adds the path's second-order term to the tangent step v = dalpha K^-1 f_ext:
   /// -K^-1 q with q = (R(u + v, s + dalpha) + R(u - v, s - dalpha)) / 2 - R(u, s), two residuals and
   /// a solve with the factor at hand (NonlinearSolver::second_order_term), where that term is at
-  /// most max_curvature_ratio of v (|.|_inf); `tangent`: the tangent step alone (before).
+  /// most a tenth of v (|.|_inf); `tangent`: the tangent step alone (before). docs/SOLVER.md.
   Predictor predictor = Predictor::second_order;
   /// The displacement-controlled path's linear solves: Newton-Krylov on a kept factorisation
   /// (default) or a fresh factorisation per Newton iteration (tangent.reuse = false).
@@ -323,8 +323,8 @@ class NonlinearSolver {
   bool predict(double d_next, std::string& why);
   /// With the tangent step -du_ = dalpha a_ to c . u = m + dalpha c . a_ from the equilibrium u_
   /// at s_: adds the path's second-order term to it (keeping c . step) and to `s_pred`, where
-  /// that term is at most kMaxCurvatureRatio of the step (|.|_inf). False (du_, s_pred unchanged)
-  /// where it is larger, or u_ -+ the step is inadmissible.
+  /// that term is at most a tenth of the step (|.|_inf). False (du_, s_pred unchanged) where it
+  /// is larger, u_ -+ the step is inadmissible or the factor's solve fails. Collective.
   bool second_order_term(double dalpha, double ca, double& s_pred);
   /// The path's result from the state it ended in (`at_target`: its last increment reached
   /// the target): max|u|, alpha, inertia, and the converged state's final check.
