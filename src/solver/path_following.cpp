@@ -382,9 +382,9 @@ bool NonlinearSolver::unstable_on_target(double d, const LoadExtremes& extremes,
 }
 
 /// The first step of a path from max|u| = d to `target`. At a load case's start (`fresh`: from
-/// rest or from the fixed loads' state), the first increment the previous load case of this
-/// problem took (its load differs, its difficulty is alike): measured on Random2D draws, this
-/// halves the discarded increments against a first try at the whole target
+/// rest or from the fixed loads' state), at most the hint the earlier load cases of this problem
+/// left (next_hint: their load differs, their difficulty is alike): measured on Random2D draws,
+/// this halves the discarded increments against a first try at the whole target
 /// (scripts/bench_generate.sh).
 double NonlinearSolver::first_step(double target, double d, bool fresh) const {
   const double step = target - d;
@@ -519,7 +519,8 @@ TargetResult NonlinearSolver::path(double target, double start, int spent, PathS
       }
       extremes.add(s_, d_next);
       failed_in_a_row = 0;
-      if (first_accepted && fresh) step_hint_ = d_next - d_start;
+      if (first_accepted && fresh)
+        step_hint_ = next_hint(step_hint_, d_next - d_start, last, t.failed_increments == 0, its - its_before);
       first_accepted = false;
       d = d_next;
       if (last) break;

@@ -100,6 +100,29 @@ TEST_CASE("The second-order predictor reaches the tangent predictor's equilibria
   CHECK(its[1] <= 0.8 * its[0]);
 }
 
+TEST_CASE("A small target does not shorten the next load cases' first increment", "[solver]") {
+  // The disk at P1 h 0.04 (the DOLFINx baseline's scene), targets 0.3, 0.1, 0.5 in turn, each
+  // from rest: 0.1 in one easy increment leaves the hint of 0.3, so 0.5 goes 0 -> 0.3 -> 0.5 (the
+  // hint set by every first increment: 0 -> 0.1 -> 0.25 -> 0.475 -> 0.5, 6 Newton iterations
+  // against 5), at the same equilibrium.
+  physics::Problem p{PETSC_COMM_WORLD, hstest::disk_mesh(0.04), hstest::disk_effects(500, 0.49), hstest::degree(1)};
+  solver::NonlinearSolver ns(p, solver::SolverOptions{});
+  solver::TargetResult t;
+  for (const double target : {0.3, 0.1, 0.5}) {
+    ns.reset();
+    t = ns.solve_for_target(target);
+    INFO("target " << target << ": " << t.reason);
+    REQUIRE(t.converged);
+  }
+  INFO(t.increments << " increments, " << t.newton_iterations << " Newton iterations");
+  CHECK(t.increments == 2);
+  CHECK(t.failed_increments == 0);
+  const double alpha = t.alpha;
+  ns.reset();
+  REQUIRE(ns.solve(alpha).converged);
+  CHECK(p.max_displacement(ns.solution()) == Approx(0.5).epsilon(1e-7));
+}
+
 namespace {
 
 /// Whether a corrector that started at |R| = rn0 and took `steps` (length of Newton's, |R| after) creeps.
@@ -123,6 +146,14 @@ TEST_CASE("Step control: growing, halving, and a creeping corrector given up", "
   CHECK(solver::next_step(0.1, 2, 2.0) == 0.2);
   CHECK(solver::next_step(0.1, 4, growth) == 0.1);
   CHECK(solver::next_step(0.1, 6, growth) == 0.05);
+  // The next load case's first increment: a whole target reached easily keeps the longer hint; a
+  // first increment the hint cut short becomes it; a hard one halves it; a halved one is kept.
+  CHECK(solver::next_hint(0, 0.3, true, true, 4) == 0.3);     // the first load case
+  CHECK(solver::next_hint(0.3, 0.1, true, true, 3) == 0.3);   // a small target, easily
+  CHECK(solver::next_hint(0.3, 0.1, true, true, 4) == 0.1);   // not so easily
+  CHECK(solver::next_hint(0.3, 0.3, false, true, 1) == 0.3);  // cut short by the hint
+  CHECK(solver::next_hint(0.3, 0.3, false, true, 6) == 0.15);
+  CHECK(solver::next_hint(0.3, 0.075, false, false, 7) == 0.075);
   // Three steps cut below 0.3 that leave |R| above half of what it was: creeping.
   CHECK_FALSE(creeps(10, {{0.1, 9}, {0.05, 8}}));  // only two steps yet
   CHECK(creeps(10, {{0.1, 9}, {0.05, 8}, {0.2, 7}}));
