@@ -101,10 +101,10 @@ TEST_CASE("The second-order predictor reaches the tangent predictor's equilibria
 }
 
 TEST_CASE("A small target does not shorten the next load cases' first increment", "[solver]") {
-  // The disk at P1 h 0.04 (the DOLFINx baseline's scene), targets 0.3, 0.1, 0.5 in turn, each
-  // from rest: 0.1 in one easy increment leaves the hint of 0.3, so 0.5 goes 0 -> 0.3 -> 0.5 (the
-  // hint set by every first increment: 0 -> 0.1 -> 0.25 -> 0.475 -> 0.5, 6 Newton iterations
-  // against 5), at the same equilibrium.
+  // The paper's disk at P1 h 0.04 (the DOLFINx baseline's, without its grading at the clamp
+  // ends), targets 0.3, 0.1, 0.5 in turn, each from rest: 0.1 in one easy increment leaves the
+  // hint of 0.3, so 0.5 goes 0 -> 0.3 -> 0.5 (the hint set by every first increment: 0 -> 0.1 ->
+  // 0.25 -> 0.475 -> 0.5, 6 Newton iterations against 5), at the same equilibrium.
   physics::Problem p{PETSC_COMM_WORLD, hstest::disk_mesh(0.04), hstest::disk_effects(500, 0.49), hstest::degree(1)};
   solver::NonlinearSolver ns(p, solver::SolverOptions{});
   solver::TargetResult t;
