@@ -57,6 +57,7 @@ std::string solver_text(const solver::SolverOptions& s) {
          (s.retry_from_rest ? "" : "  retry_from_rest: false\n") +
          (s.p1_start ? "" : "  p1_start: false\n") +  // the default (2026-11-29): older identities unchanged
          (s.predictor == solver::Predictor::second_order ? "" : "  predictor: tangent\n") +  // likewise
+         (s.corrector == solver::Corrector::chebyshev ? "" : "  corrector: newton\n") +  // likewise (2026-11-29)
          (s.tangent.single_factor ? "  factor_precision: single\n" : "");
 }
 

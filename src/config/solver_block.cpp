@@ -42,6 +42,12 @@ void parse_solver_block(const YamlBlock& sol, solver::SolverOptions& s) {
     else if (p == "tangent") s.predictor = solver::Predictor::tangent;
     else sol.fail("predictor", "must be second_order or tangent");
   }
+  if (sol.has("corrector")) {
+    const std::string c = sol.text("corrector");
+    if (c == "chebyshev") s.corrector = solver::Corrector::chebyshev;
+    else if (c == "newton") s.corrector = solver::Corrector::newton;
+    else sol.fail("corrector", "must be chebyshev (the last increment's step plus its second-order term) or newton");
+  }
   if (sol.has("branch_switches")) s.branch_switches = int(sol.integer("branch_switches"));
   if (s.branch_switches < 0 || s.branch_switches > 10) sol.fail("branch_switches", "must be in [0, 10]");
   if (sol.has("linear")) {
@@ -59,7 +65,7 @@ void parse_solver_block(const YamlBlock& sol, solver::SolverOptions& s) {
   if (s.tangent.reuse && (s.tangent.linear == solver::LinearSolver::gamg || s.tangent.linear == solver::LinearSolver::hypre))
     sol.fail("factor_reuse", "must be false with linear: gamg or hypre (a kept factor is the direct solver's)");
   sol.allowed("rtol, max_newton, factor_reuse, krylov_budget, krylov_rtol, max_increments, target_rtol, control, path_rtol, newton_budget, fallback, "
-              "branch_switches, step_growth, abandon_off_path, arc_length_rescue, retry_from_rest, p1_start, predictor, linear, linear_auto_dofs, factor_precision");
+              "branch_switches, step_growth, abandon_off_path, arc_length_rescue, retry_from_rest, p1_start, predictor, corrector, linear, linear_auto_dofs, factor_precision");
   sol.check_all_used();
 }
 

@@ -91,6 +91,7 @@ bad types off_path_word  2 "solver.abandon_off_path: must be true or false" "$(a
 bad types retry_word     2 "solver.retry_from_rest: must be true or false" "$(add 'solver: {retry_from_rest: often}')"
 bad types factor_half    2 "solver.factor_precision: must be double or single" "$(add 'solver: {factor_precision: half}')"
 bad types predictor_word 2 "solver.predictor: must be second_order or tangent" "$(add 'solver: {predictor: cubic}')"
+bad types corrector_word 2 "solver.corrector: must be chebyshev" "$(add 'solver: {corrector: halley}')"
 bad types r3_finer_mesh  2 "mesh.surface_h: must be in [shapes.h = 0.1, mesh.h = 0.2]" "$(sub 's/^preset: random2d/preset: random3d/; s/shapes: {count: 2, h: 0.2}/shapes: {count: 1}\nmesh: {h: 0.2}/')"
 bad types linear_word     2 "solver.linear: must be auto, direct, gamg or hypre" "$(add 'solver: {linear: amg}')"
 

@@ -228,6 +228,7 @@ TEST_CASE("Newton-Krylov on a kept factor reaches the fresh-Newton equilibrium w
     // The same predictor on both: with a kept factor the path takes the tangent step alone (the
     // second-order term needs the factor a_ was solved with).
     direct.predictor = solver::Predictor::tangent;
+    direct.corrector = solver::Corrector::newton;  // likewise Newton's corrector step
     solver::SolverOptions reuse;
     reuse.tangent.reuse = true;
     const Solved fresh(p, direct, c.target), kept(p, reuse, c.target);

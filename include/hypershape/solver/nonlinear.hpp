@@ -34,7 +34,8 @@
 ///   - corrector: bordered Newton; the u-part of each step is Newton's step at the load
 ///     alpha + dalpha and goes through the same guarded energy line search (never a state with
 ///     det F <= 0), alpha moving by the same fraction; intermediate increments are converged
-///     to path_rtol only, the last to rtol;
+///     to path_rtol only, the last to rtol, with Chebyshev's step there (Newton's plus its
+///     second-order term; SolverOptions::corrector);
 ///   - an increment that fails (max_newton iterations, no progress after 4, Newton creeping:
 ///     three steps cut below 0.3 by the line search without halving |R|, or, with
 ///     abandon_off_path, an iterate that left the path: off_the_path) is discarded,
@@ -87,6 +88,12 @@ enum class Predictor {
   second_order,  ///< the tangent step plus the path's second-order term where it is small
 };
 
+/// The displacement-controlled path's corrector step in its last increment (SolverOptions::corrector).
+enum class Corrector {
+  newton,     ///< Newton's (bordered) step (the only one until 2026-11-29)
+  chebyshev,  ///< Newton's step plus its second-order term where that is small (Chebyshev's method)
+};
+
 struct SolverOptions {
   double rtol = 1e-9;          ///< converged when ||R|| <= rtol ||alpha f_ext|| (+ atol)
   double atol = 1e-12;
@@ -137,6 +144,14 @@ struct SolverOptions {
   /// a solve with the factor at hand (NonlinearSolver::second_order_term), where that term is at
   /// most a tenth of v (|.|_inf); `tangent`: the tangent step alone (before). docs/SOLVER.md.
   Predictor predictor = Predictor::second_order;
+  /// Displacement control: the corrector's step in the last increment (converged to rtol; the
+  /// intermediate ones, converged to path_rtol only, take Newton's). `chebyshev` (default since
+  /// 2026-11-29) adds to Newton's step delta its second-order term -K^-1 q, q = (R(u + delta) +
+  /// R(u - delta)) / 2 - R(u) (Chebyshev's method: the error falls with its cube near a solution),
+  /// where that term is at most delta (|.|_inf): two residuals and a solve with the factor at hand
+  /// per iteration (NonlinearSolver::chebyshev_step). `newton`: Newton's step alone (before).
+  /// docs/SOLVER.md, "corrector".
+  Corrector corrector = Corrector::chebyshev;
   /// The displacement-controlled path's linear solves: Newton-Krylov on a kept factorisation
   /// (default) or a fresh factorisation per Newton iteration (tangent.reuse = false).
   TangentOptions tangent;
@@ -326,6 +341,21 @@ class NonlinearSolver {
   /// that term is at most a tenth of the step (|.|_inf). False (du_, s_pred unchanged) where it
   /// is larger, u_ -+ the step is inadmissible or the factor's solve fails. Collective.
   bool second_order_term(double dalpha, double ca, double& s_pred);
+  /// The second-order term of R along the step v = -du_ from u_: K^-1 q into curvature_, with
+  /// q = (R(u_ + v, s + ds) + R(u_ - v, s - ds)) / 2 - R(u_, s) = D^2 R[v, v] / 2 + O(|v|^4) (the
+  /// load terms cancel), `q` a scratch vector. Returns |K^-1 q|_inf / |v|_inf, or a negative value
+  /// where u_ -+ v is inadmissible or the factor's solve fails (with the factor at hand, unrefined
+  /// where it is single precision). Collective.
+  double curvature_along_step(double s, double ds, Vec q);
+  /// Adds the term curvature_along_step left, -K^-1 q, to the step -du_, with the multiple of
+  /// a_ (= K^-1 f_ext) that keeps c . step; returns that multiple (the load's change). Collective.
+  double add_curvature_term(double ca);
+  /// Whether the corrector converging to `rtol` takes Chebyshev's step (SolverOptions::corrector:
+  /// in the last increment, with a direct factor at hand).
+  bool chebyshev_corrector(double rtol) const;
+  /// The corrector's step -du_ (Newton's, at the load s) plus its second-order term where that is
+  /// at most as long; `r` holds R(u_, s) and is moved to the load s + the returned change.
+  double chebyshev_step(double s, double ca, Vec r);
   /// The path's result from the state it ended in (`at_target`: its last increment reached
   /// the target): max|u|, alpha, inertia, and the converged state's final check.
   void finish_path(TargetResult& t, bool at_target);
