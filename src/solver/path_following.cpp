@@ -368,8 +368,8 @@ double NonlinearSolver::chebyshev_step(double s, double ca, Vec r) {
   // deterministic; docs/SOLVER.md): Random2D P2 seed 2024, 20 x 25: 8045 -> 7402 (in every
   // increment, the term up to 0.3 of delta: 7661 at 1.13x the CPU); P1: 4891 -> 4389; Random3D
   // seed 90210, 10 x 20: 1995 -> 1768 (in every increment 1733, at 1.03x the CPU: a residual
-  // costs a fair share of a Newton iteration there too); with the term up to 0.3 of delta in
-  // the last increment: 2D P2 7381, 3D 1988 (one load case lost).
+  // costs a fair share of a Newton iteration there too); with the term up to 0.3 of delta: 2D P2
+  // 7381 (the last increment), 3D 1988 (every increment; one load case lost).
   constexpr double kMaxRatio = 1.0;
   Vec q = b_;  // free until the line search
   const double ratio = curvature_along_step(s, 0.0, q);
