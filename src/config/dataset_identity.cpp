@@ -58,6 +58,7 @@ std::string solver_text(const solver::SolverOptions& s) {
          (s.p1_start ? "" : "  p1_start: false\n") +  // the default (2026-11-29): older identities unchanged
          (s.predictor == solver::Predictor::second_order ? "" : "  predictor: tangent\n") +  // likewise
          (s.corrector == solver::Corrector::chebyshev ? "" : "  corrector: newton\n") +  // likewise (2026-11-29)
+         (s.local_relaxation ? "" : "  local_relaxation: false\n") +  // the default (2026-11-29): older identities unchanged
          (s.tangent.single_factor ? "  factor_precision: single\n" : "");
 }
 

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <numeric>
 #include <stdexcept>
 
 #include "hypershape/core/error.hpp"
@@ -297,6 +298,8 @@ void Space::build_cells() {
   HS_PETSC(DMGetLocalSection(dm_, &ls));
   HS_PETSC(DMGetGlobalSection(dm_, &gs));
   HS_PETSC(DMPlexGetHeightStratum(dm_, 0, &c0_, &c1_));
+  all_cells_.resize(std::size_t(c1_ - c0_));
+  std::iota(all_cells_.begin(), all_cells_.end(), c0_);
   const PetscInt nloc = c1_ - c0_;
   invJ_.resize(std::size_t(nloc) * dim_ * dim_);
   detJ_.resize(nloc);

@@ -66,30 +66,7 @@ std::optional<std::string> give_up_reason(int failed_in_a_row, int its, double s
 }  // namespace
 
 const std::vector<PetscInt>& NonlinearSolver::global_of_local() {
-  if (!global_of_local_.empty()) return global_of_local_;
-  DM dm = problem_.dm();
-  core::VecH g = problem_.create_vector();
-  PetscInt lo, hi;
-  HS_PETSC(VecGetOwnershipRange(g, &lo, &hi));
-  {
-    core::VecArray<PetscScalar> gv(g);
-    for (PetscInt i = lo; i < hi; ++i) gv[i - lo] = PetscScalar(i);
-  }
-  Vec l;
-  HS_PETSC(DMGetLocalVector(dm, &l));
-  HS_PETSC(VecSet(l, -1.0));  // constrained entries: the global vector has none
-  HS_PETSC(DMGlobalToLocal(dm, g, INSERT_VALUES, l));
-  PetscInt n;
-  HS_PETSC(VecGetLocalSize(l, &n));
-  global_of_local_.assign(std::size_t(n), -1);
-  {
-    core::VecArray<const PetscScalar> lv(l);
-    for (PetscInt i = 0; i < n; ++i) {
-      const auto k = PetscInt(std::llround(PetscRealPart(lv[i])));
-      global_of_local_[std::size_t(i)] = k >= lo && k < hi ? k : -1;  // owned entries only
-    }
-  }
-  HS_PETSC(DMRestoreLocalVector(dm, &l));
+  if (global_of_local_.empty()) global_of_local_ = global_of_local_dofs(problem_);
   return global_of_local_;
 }
 
@@ -134,6 +111,22 @@ double NonlinearSolver::constraint(Vec u, Vec fallback, Vec c) {
   return cu - arc_offset_;
 }
 
+bool NonlinearSolver::relax_patch(PetscReal& rn) {
+  if (!opt_.local_relaxation || !problem_.conservative() || tangent_->multigrid()) return false;
+  PetscMPIInt size;
+  MPI_Comm_size(problem_.comm(), &size);
+  if (size > 1) return false;
+  if (!relaxation_) relaxation_ = std::make_unique<LocalRelaxation>(problem_);
+  const LocalRelaxation::Result res = relaxation_->relax(u_, s_, r_, c_);
+  relaxation_steps_ += res.iterations;
+  if (!res.relaxed) return false;
+  if (!residual_at(u_, s_, r_)) throw std::logic_error("a relaxed state is inadmissible");
+  HS_PETSC(VecNorm(r_, NORM_2, &rn));
+  HS_PETSC(PetscInfo(snes_.get(), "local relaxation: %d dofs, |R| there %g -> %g in %d steps; |R| %g\n", res.dofs,
+                     res.before, res.after, res.iterations, double(rn)));
+  return true;
+}
+
 bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why) {
   LogEvent event(events().corrector);
   const double fnorm = problem_.load_norm();
@@ -152,6 +145,8 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
   constexpr double eta_path = 0.1;
   tangent_->set_forcing(rtol > opt_.rtol ? std::max(eta_path, opt_.tangent.krylov_rtol) : opt_.tangent.krylov_rtol);
   for (int k = 0;; ++k) {
+    // Not near round-off, where Newton converges quadratically anyway (relative 1e-5).
+    if (rn > opt_.atol + std::max(rtol, 1e-5) * std::abs(s_) * fnorm && relax_patch(rn) && k == 0) rn0 = rn;
     const double m = constraint(u_, a_, c_);
     const double g = m - d;
     if (!std::isfinite(rn)) {

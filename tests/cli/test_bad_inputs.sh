@@ -92,6 +92,7 @@ bad types retry_word     2 "solver.retry_from_rest: must be true or false" "$(ad
 bad types factor_half    2 "solver.factor_precision: must be double or single" "$(add 'solver: {factor_precision: half}')"
 bad types predictor_word 2 "solver.predictor: must be second_order or tangent" "$(add 'solver: {predictor: cubic}')"
 bad types corrector_word 2 "solver.corrector: must be chebyshev" "$(add 'solver: {corrector: halley}')"
+bad types relax_word     2 "solver.local_relaxation: must be true or false" "$(add 'solver: {local_relaxation: sometimes}')"
 bad types r3_finer_mesh  2 "mesh.surface_h: must be in [shapes.h = 0.1, mesh.h = 0.2]" "$(sub 's/^preset: random2d/preset: random3d/; s/shapes: {count: 2, h: 0.2}/shapes: {count: 1}\nmesh: {h: 0.2}/')"
 bad types linear_word     2 "solver.linear: must be auto, direct, gamg or hypre" "$(add 'solver: {linear: amg}')"
 

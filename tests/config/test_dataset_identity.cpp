@@ -48,7 +48,7 @@ shapes:
   count: 4
 seed: 3
 name: same
-solver: {rtol: 1.0e-9, linear: auto, step_growth: 0, abandon_off_path: false, arc_length_rescue: false, retry_from_rest: true, predictor: second_order, corrector: chebyshev}
+solver: {rtol: 1.0e-9, linear: auto, step_growth: 0, abandon_off_path: false, arc_length_rescue: false, retry_from_rest: true, predictor: second_order, corrector: chebyshev, local_relaxation: true}
 petsc: {}
 preset: random2d
 )") == a);
@@ -67,7 +67,7 @@ TEST_CASE("a different value is a different dataset", "[config][identity]") {
                              "solver: {abandon_off_path: true}\n", "solver: {arc_length_rescue: true}\n",
                              "solver: {retry_from_rest: false}\n",
                              "solver: {step_growth: 2}\n", "solver: {predictor: tangent}\n",
-                             "solver: {corrector: newton}\n"}) {
+                             "solver: {corrector: newton}\n", "solver: {local_relaxation: false}\n"}) {
     std::string t = base;
     const std::string key = std::string(change).substr(0, std::string(change).find(':') + 1);
     if (auto p = t.find(key); p != std::string::npos) t.erase(p, t.find('\n', p) - p + 1);

@@ -174,7 +174,7 @@ class HyperelasticEffect : public Effect {
     return detail::dispatch(s, [&]<int D, int NB>() {
       const auto& k = kernel<D>();
       Eigen::Matrix<double, NB, D> ue, G;
-      for (PetscInt c = s.cell_begin(); c < s.cell_end(); ++c) {
+      for (PetscInt c : s.cells()) {
         detail::gather<D, NB>(s, c, u, ue);
         const double dj = s.det_jacobian(c);
         for (int q = 0; q < s.n_qp(); ++q) {
@@ -194,7 +194,7 @@ class HyperelasticEffect : public Effect {
       const auto& k = kernel<D>();
       Eigen::Matrix<double, NB, D> ue, G, re;
       Tensor<D> P;
-      for (PetscInt c = s.cell_begin(); c < s.cell_end(); ++c) {
+      for (PetscInt c : s.cells()) {
         detail::gather<D, NB>(s, c, u, ue);
         const double dj = s.det_jacobian(c);
         re.setZero();
@@ -220,7 +220,7 @@ class HyperelasticEffect : public Effect {
       const auto& k = kernel<D>();
       Eigen::Matrix<double, NB, D> ue, G, re;
       Tensor<D> P;
-      for (PetscInt c = s.cell_begin(); c < s.cell_end(); ++c) {
+      for (PetscInt c : s.cells()) {
         detail::gather<D, NB>(s, c, u, ue);
         const double dj = s.det_jacobian(c);
         re.setZero();
@@ -253,7 +253,7 @@ class HyperelasticEffect : public Effect {
       Tensor<D> P;
       Tangent<D> A;
       const CellMatrixAdder adder(s, J);
-      for (PetscInt c = s.cell_begin(); c < s.cell_end(); ++c) {
+      for (PetscInt c : s.cells()) {
         detail::gather<D, NB>(s, c, u, ue);
         const double dj = s.det_jacobian(c);
         Ke.setZero();

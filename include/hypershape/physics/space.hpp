@@ -7,6 +7,7 @@
 
 #include <array>
 #include <string>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -84,6 +85,9 @@ class Space {
   int n_cell_dofs() const { return n_nodes_ * dim_; }
   PetscInt cell_begin() const { return c0_; }
   PetscInt cell_end() const { return c1_; }
+  /// The cells the assembly loops visit, in order: every local cell, or the subset a
+  /// CellSubset has made active (a local solve's patch: src/solver/local_relaxation.cpp).
+  std::span<const PetscInt> cells() const { return subset_ ? *subset_ : std::span<const PetscInt>(all_cells_); }
   std::int64_t n_cells_global() const { return n_cells_global_; }
   std::int64_t n_dofs_global() const { return n_dofs_global_; }  ///< unconstrained dofs
   std::int64_t n_vertices_global() const { return n_vertices_global_; }
@@ -167,6 +171,9 @@ class Space {
   core::FEH fe_;
   int dim_ = 0, degree_ = 1, n_nodes_ = 0, n_qp_ = 0;
   PetscInt c0_ = 0, c1_ = 0;
+  std::vector<PetscInt> all_cells_;  ///< c0_, ..., c1_ - 1
+  friend class CellSubset;
+  mutable const std::vector<PetscInt>* subset_ = nullptr;  ///< CellSubset's cells, or null
   std::int64_t n_cells_global_ = 0, n_dofs_global_ = 0, n_vertices_global_ = 0,
                n_nodes_global_ = 0;
   std::vector<double> qw_, N_, dN_, qxi_;
@@ -177,6 +184,20 @@ class Space {
   std::vector<OwnedNode> owned_nodes_;
   std::vector<std::int64_t> canonical_cells_;
   std::vector<double> canonical_coords_;
+};
+
+/// While it lives, the assembly loops of `space` (Space::cells) visit only `cells` (sorted, local
+/// cell numbers): the energy, residual and tangent of a patch, exact at the dofs whose cells all
+/// lie in it. Not nested; not collective.
+class CellSubset {
+ public:
+  CellSubset(const Space& space, const std::vector<PetscInt>& cells) : space_(space) { space_.subset_ = &cells; }
+  ~CellSubset() { space_.subset_ = nullptr; }
+  CellSubset(const CellSubset&) = delete;
+  CellSubset& operator=(const CellSubset&) = delete;
+
+ private:
+  const Space& space_;
 };
 
 }  // namespace hypershape::physics

@@ -72,6 +72,7 @@
 
 #include "hypershape/core/petsc_handle.hpp"
 #include "hypershape/physics/problem.hpp"
+#include "hypershape/solver/local_relaxation.hpp"
 #include "hypershape/solver/tangent.hpp"
 
 namespace hypershape::solver {
@@ -152,6 +153,9 @@ struct SolverOptions {
   /// per iteration (NonlinearSolver::chebyshev_step). `newton`: Newton's step alone (before).
   /// docs/SOLVER.md, "corrector".
   Corrector corrector = Corrector::chebyshev;
+  /// Nonlinear elimination: before each corrector step, where the residual sits on a few nodes,
+  /// relax them on their patch first (LocalRelaxation).
+  bool local_relaxation = true;
   /// The displacement-controlled path's linear solves: Newton-Krylov on a kept factorisation
   /// (default) or a fresh factorisation per Newton iteration (tangent.reuse = false).
   TangentOptions tangent;
@@ -363,6 +367,10 @@ class NonlinearSolver {
   /// current iterate in u_/s_; returns false with `why` set on failure. Leaves in `a_` the
   /// tangent response K^-1 f_ext of its last factorisation (the next predictor).
   bool correct(double d, double rtol, int& its, std::string& why);
+  /// SolverOptions::local_relaxation: relaxes u_ on the patch where R (in r_) sits
+  /// (LocalRelaxation); where it did, r_ and `rn` are the relaxed state's. One rank,
+  /// conservative problems, a direct factor.
+  bool relax_patch(PetscReal& rn);
   /// With abandon_off_path: whether a corrector iterate of an intermediate increment (`rtol` above
   /// the final one), on the increment's first try, has left the path: its tangent has more
   /// negative pivots than at the increment's start and the line search cut its step (`lambda`)
@@ -449,6 +457,8 @@ class NonlinearSolver {
   bool arc_ = false;         ///< predict/correct constrain c . u (arc_dir_), not max|u|
   double arc_offset_ = 0;    ///< arc_dir_ . u at the increment's start
   std::vector<PetscInt> global_of_local_;  ///< see global_of_local()
+  std::unique_ptr<LocalRelaxation> relaxation_;  ///< relax_patch's (made at its first use)
+  long relaxation_steps_ = 0;  ///< local Newton steps of relax_patch
   double s_ = 0;        ///< load factor of the current state
   double s_eval_ = 0;   ///< load factor the callbacks assemble at
   /// The stored energy and internal force of the last trial backtrack evaluated (NaN: none),

@@ -127,7 +127,7 @@ class MeanDilatationNeoHookean : public Effect {
     return detail::dispatch(s, [&]<int D, int NB>() {
       Eigen::Matrix<double, NB, D> ue, G;
       Cell<D, NB> cell;
-      for (PetscInt c = s.cell_begin(); c < s.cell_end(); ++c) {
+      for (PetscInt c : s.cells()) {
         detail::gather<D, NB>(s, c, u, ue);
         const double dj = s.det_jacobian(c);
         cell.V = cell.v = 0;

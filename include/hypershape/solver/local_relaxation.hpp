@@ -1,0 +1,65 @@
+#pragma once
+/// Nonlinear elimination of a local trouble spot (Cai & Keyes 2002; Hwang & Cai 2007): where the
+/// residual of a Newton iterate sits on a few nodes -- the clamp's or the load's patch ends, where
+/// a linearised step over-stretches a handful of cells -- the corrector's global Newton steps
+/// creep, cut by the energy line search to what those cells allow. LocalRelaxation minimises the
+/// energy over the dofs of a small patch around those nodes instead, everything else held, by
+/// dense Newton steps on the patch (shifted where its tangent is indefinite, so that they
+/// descend), before the corrector's next global step. One rank, conservative problems
+/// (an energy to descend).
+#include <petscmat.h>
+#include <petscvec.h>
+
+#include <vector>
+
+#include "hypershape/core/petsc_handle.hpp"
+#include "hypershape/physics/problem.hpp"
+
+namespace hypershape::solver {
+
+/// The global index of every local-vector entry of `problem` (-1: constrained or not owned here).
+/// Collective.
+std::vector<PetscInt> global_of_local_dofs(const physics::Problem& problem);
+
+class LocalRelaxation {
+ public:
+  /// Collective (the dof maps); relax() then works on rank-local data only.
+  explicit LocalRelaxation(const physics::Problem& problem);
+
+  struct Result {
+    bool relaxed = false;  ///< u was changed
+    int iterations = 0;    ///< local Newton steps taken
+    int dofs = 0;          ///< dofs of the patch
+    double before = 0;     ///< |R| on the patch's dofs before
+    double after = 0;      ///< and after
+  };
+  /// `r` = R(u, s) (global). Where more than half of |R|^2 sits on at most kMaxSeeds nodes (those
+  /// with |R_node| >= a tenth of the largest), relaxes u on the patch of cells within two rings of
+  /// them (the dofs whose cells all lie in the patch; not those where `fixed`, a global vector, is
+  /// non-zero: the control node), until the patch's residual is a tenth of the rest's or a
+  /// hundredth of its start. u stays admissible; `r` is stale where relaxed.
+  Result relax(Vec u, double s, Vec r, Vec fixed);
+
+  static constexpr int kMaxSeeds = 32;
+
+ private:
+  /// The dofs of the patch around `seeds` (nodes: first local dof / dim), into cells_, free_.
+  void patch(const std::vector<PetscInt>& seeds, const PetscScalar* fixed);
+  /// R on free_ at u (the patch's cells only) into rf; false where u is inadmissible.
+  bool patch_residual(Vec u, double s, std::vector<double>& rf);
+  /// The energy at u with the patch's cells only (the rest is constant); false if inadmissible.
+  bool patch_energy(Vec u, double s, double& e);
+
+  const physics::Problem& problem_;
+  int dim_;
+  std::vector<PetscInt> gol_;                     ///< global_of_local_dofs
+  std::vector<PetscInt> node_cells_ptr_, node_cells_;  ///< cells of each node (CSR by node)
+  std::vector<PetscInt> cells_;                   ///< the patch's cells, sorted
+  std::vector<PetscInt> free_;                    ///< the patch's free dofs (global indices)
+  std::vector<char> in_patch_;                    ///< per local cell
+  std::vector<int> position_;                     ///< global dof -> index in free_ (-1)
+  core::VecH work_, trial_;
+  core::MatH K_;                                  ///< the patch's tangent (the full pattern)
+};
+
+}  // namespace hypershape::solver
