@@ -8,7 +8,11 @@ from the arrays), splits.json and stats.json. Exit 0 if identical, 1 with the di
                                       (solver groups of several ranks sum in another order;
                                       the labels' error estimates, loads/error_estimate_*, are
                                       then only checked to be present with the same shape: see
-                                      ESTIMATE_NOTE)"""
+                                      ESTIMATE_NOTE)
+  ... --rtol R --paths-differ         also the path counters (PATH_ARRAYS: how the solver got
+                                      there) and the reasons only checked for shape: two solvers
+                                      that reach the same equilibria by other paths (a solver
+                                      group does not relax patches: SolverOptions::local_relaxation)"""
 import json
 import os
 import sys
@@ -31,6 +35,8 @@ RTOL = 0.0
 # a hard load case of the tiny h 0.1 dataset, and may turn one into -1 (no estimate). They are
 # bit for bit on any number of ranks with solver groups of one rank (the default).
 ESTIMATE_NOTE = "error estimates not compared under --rtol (partition-dependent)"
+PATHS_DIFFER = False
+PATH_ARRAYS = ("/solves", "/newton_iterations", "/failed_increments", "/recovery_iterations", "/reason")
 
 
 def same(x, y):
@@ -72,7 +78,7 @@ def compare_h5(a, b, errors):
                 errors.append(f"{a}:{path}: attribute {k} differs")
         if isinstance(x, h5py.Dataset):
             n += 1
-            if RTOL > 0 and "/error_estimate_" in path:
+            if (RTOL > 0 and "/error_estimate_" in path) or (PATHS_DIFFER and path.endswith(PATH_ARRAYS)):
                 if x.shape != y.shape:
                     errors.append(f"{a}:{path}: shapes differ")
                 continue
@@ -104,11 +110,16 @@ def main(da, db):
     for e in errors[:20]:
         print("DIFF", e)
     note = f" ({ESTIMATE_NOTE})" if RTOL > 0 else ""
+    if PATHS_DIFFER:
+        note += " (path counters and reasons not compared)"
     print(f"compared {len(sa)} shards, {n} arrays: {'identical' if not errors else f'{len(errors)} differences'}{note}")
     return 0 if not errors else 1
 
 
 if __name__ == "__main__":
-    if len(sys.argv) == 5 and sys.argv[3] == "--rtol":
+    if len(sys.argv) in (5, 6) and sys.argv[3] == "--rtol":
         RTOL = float(sys.argv[4])
+        PATHS_DIFFER = sys.argv[5:] == ["--paths-differ"]
+        if len(sys.argv) == 6 and not PATHS_DIFFER:
+            sys.exit(f"unknown option {sys.argv[5]}")
     sys.exit(main(sys.argv[1], sys.argv[2]))

@@ -10,7 +10,8 @@ sed -E 's/^shapes: \{count: [0-9]+/shapes: {count: 2/; s/^loads: \{count: [0-9]+
 mpiexec -n 2 "$bin" -q generate "$work/clamps.yaml" --progress 0 -o "$work/np2" || fail "2-rank run"
 mpiexec -n 2 "$bin" -q generate "$work/clamps.yaml" --progress 0 --group-size 2 -o "$work/g2" || fail "group of 2"
 compare "$work/np1" "$work/np2" >/dev/null && ok "1 rank == 2 ranks, bit for bit" || fail "1 rank != 2 ranks"
-compare "$work/np1" "$work/g2" --rtol 1e-9 >/dev/null && ok "1 rank == a group of 2 ranks, to 1e-9" || fail "1 rank != g2"
+# (a group does not relax patches before the corrector's steps: the same equilibria by other paths)
+compare "$work/np1" "$work/g2" --rtol 1e-7 --paths-differ >/dev/null && ok "1 rank == a group of 2 ranks, the same equilibria to 1e-7" || fail "1 rank != g2"
 /usr/bin/python3 "$src/scripts/hypershape_data.py" check "$work/np1" >/dev/null && ok "hypershape_data.py check" || fail "check"
 /usr/bin/python3 - "$work/np1" <<'PY' && ok "Dirichlet facets = patch + regions; mask on their nodes; no traction inside them" || fail "supports stored"
 import sys

@@ -90,9 +90,12 @@ TEST_CASE("Unseen-seed load cases that need a branch switch end stable on target
   // 2024/12/17 on the tangent predictor's path: with the second-order predictor (the default since
   // 2026-11-29) it is lost alone (the budget spent after two switches) and reached in the
   // factory's order after a switch (156 Newton iterations), which the next test case checks.
+  // Without local relaxation: with it (the default since 2026-11-29) 2024/12/17 and 777/3/47
+  // reach their targets without a switch (17 and 38 Newton iterations).
   const std::vector<std::tuple<int, int, int>> cases = {{2024, 12, 17}, {777, 3, 47}, {31337, 7, 42}};
   for (const auto& [seed, shape_id, load_id] : cases) {
     Case c(std::uint64_t(seed), shape_id);
+    c.cfg.solver.local_relaxation = false;
     const auto& lc = c.set(load_id);
     if (seed == 2024) c.cfg.solver.predictor = solver::Predictor::tangent;
     solver::NonlinearSolver ns(*c.sp.problem, c.cfg.solver);
@@ -107,10 +110,12 @@ TEST_CASE("Unseen-seed load cases that need a branch switch end stable on target
 
 namespace {
 
-/// Replays loads 0..load of `shape_id` of `seed` as the factory solves them (the default solver):
-/// the last must end stable on target after a branch switch.
+/// Replays loads 0..load of `shape_id` of `seed` as the factory solves them (the default solver,
+/// without local relaxation: with it, these paths reach their targets without a switch): the
+/// last must end stable on target after a branch switch.
 void check_switched_in_factory_order(int seed, int shape_id, int load) {
   Case c(std::uint64_t(seed), shape_id);
+  c.cfg.solver.local_relaxation = false;
   solver::NonlinearSolver ns(*c.sp.problem, c.cfg.solver);
   const auto r = replay(c, ns, 0, load);
   INFO(r.reason);
@@ -131,7 +136,7 @@ TEST_CASE("Local relaxation: a Random2D P2 load case in a quarter of the Newton 
   // Seed 2024, shape 0, load 5 of 25 at the random2d preset (P2 h 0.12), alone from rest: without
   // relaxation the first increment (to the target) creeps and fails, and its half takes 10
   // corrector iterations whose residual sits on a few nodes by the clamp's end (21 Newton
-  // iterations in all); relaxing them first, the first increment reaches the target in 5.
+  // iterations in all); relaxing them first, the first increment reaches the target in 3.
   Case c(2024, 0, HS_SOURCE_DIR "/configs/presets/random2d.yaml", 0, 0, 25);
   const auto& lc = c.set(5);
   solver::SolverOptions plain = c.cfg.solver;
@@ -237,9 +242,11 @@ TEST_CASE("A branch switch leaves along the tangent's lowest mode and not the mo
   // curvature (both found the mode nearest zero), took 24 recovery iterations; with K's lowest
   // mode (inverse iteration with the definite shifted tangent) for both, 9 (15 with it in the
   // minimisation only). On Newton's corrector: with Chebyshev's last step (the default since
-  // 2026-11-29) this path ends on a stable state without a switch.
+  // 2026-11-29) this path ends on a stable state without a switch; likewise without local
+  // relaxation (the default since 2026-11-29).
   Case c(777, 13);
   c.cfg.solver.corrector = solver::Corrector::newton;
+  c.cfg.solver.local_relaxation = false;
   solver::NonlinearSolver ns(*c.sp.problem, c.cfg.solver);
   const auto r = replay(c, ns, 0, 0);
   INFO(r.reason);
@@ -255,9 +262,13 @@ TEST_CASE("A target on the unstable segment of a fold is reported as a fold", "[
   // branch switches, the state is checked independently: an equilibrium on target, one negative
   // eigenvalue (a fresh MUMPS LDL^T), and max|u| falling when the load is raised by 1e-6 relative
   // (a load-controlled Newton solve from it: d max|u| / d alpha < 0).
+  // Without local relaxation: with it (the default since 2026-11-29) a branch switch from
+  // 31337/4/30's fold finds a stable state on target (132 Newton iterations): a fold of the path
+  // from rest, and a stable branch elsewhere.
   const std::vector<std::tuple<int, int, int, int>> cases = {{777, 10, 28, 0}, {31337, 4, 30, 0}};
   for (const auto& [seed, shape_id, load_id, from] : cases) {
     Case c(std::uint64_t(seed), shape_id);
+    c.cfg.solver.local_relaxation = false;
     const double target = c.loads[std::size_t(load_id)].target;
     {
       solver::NonlinearSolver ns(*c.sp.problem, c.cfg.solver);
@@ -350,9 +361,11 @@ TEST_CASE("An increment whose iterate leaves the path is abandoned, and the path
   // target, in the equilibrium a load-controlled solve from rest to the same alpha reaches; by
   // default (off) no increment is abandoned so.
   // The increments were found with the former step growth of 2 (with 1.5, load 8's predictors
-  // no longer overshoot so): the test keeps it, to exercise the mechanism.
+  // no longer overshoot so): the test keeps it, to exercise the mechanism; and without local
+  // relaxation (the default since 2026-11-29), which leaves no such increment in these two.
   Case c(2024, 0);
   c.cfg.solver.step_growth = 2.0;
+  c.cfg.solver.local_relaxation = false;
   solver::SolverOptions opt = c.cfg.solver;
   opt.abandon_off_path = true;
   for (const int load_id : {5, 8}) {
@@ -403,6 +416,7 @@ TEST_CASE("The arc-length rescue ends stable on target where the path and its br
     // The cases are the tangent predictor's: with the second-order one (the default since
     // 2026-11-29) both reach the target without the rescue.
     opt.predictor = solver::Predictor::tangent;
+    opt.local_relaxation = false;  // likewise local relaxation (the default since 2026-11-29)
     opt.step_growth = growth;  // 0: the default
     solver::NonlinearSolver ns(*c.sp.problem, opt);
     const auto r = replay(c, ns, 0, load_id);
@@ -445,9 +459,11 @@ TEST_CASE("A P2 load case lost on every path from rest is reached from the P1 so
   // branch switch end on a verified stable equilibrium on target (alpha 42.3).
   // On the tangent predictor's path: with the second-order one (the default since 2026-11-29)
   // this load case converges alone (154 Newton iterations, a branch switch), so it would not
-  // exercise the rescue.
+  // exercise the rescue; nor with local relaxation (the default since 2026-11-29: alone, 58 Newton
+  // iterations, no switch).
   Case c(12345, 19, HS_SOURCE_DIR "/configs/presets/random2d.yaml");
   c.cfg.solver.predictor = solver::Predictor::tangent;
+  c.cfg.solver.local_relaxation = false;
   solver::NonlinearSolver ns(*c.sp.problem, c.cfg.solver);
   const auto r = from_p1(c, ns, 5);
   REQUIRE(r);  // it failed alone (the case the rescue is for) and P1 converged

@@ -34,8 +34,8 @@ class LocalRelaxation {
     double after = 0;      ///< and after
   };
   /// `r` = R(u, s) (global). Where more than half of |R|^2 sits on at most kMaxSeeds nodes (those
-  /// with |R_node| >= a tenth of the largest), relaxes u on the patch of cells within two rings of
-  /// them (the dofs whose cells all lie in the patch; not those where `fixed`, a global vector, is
+  /// with |R_node| >= a tenth of the largest), relaxes u on the patch of cells within three rings
+  /// of them in 2D, two in 3D (the dofs whose cells all lie in the patch; not those where `fixed`, a global vector, is
   /// non-zero: the control node), until the patch's residual is a tenth of the rest's or a
   /// hundredth of its start. u stays admissible; `r` is stale where relaxed.
   Result relax(Vec u, double s, Vec r, Vec fixed);
@@ -43,7 +43,7 @@ class LocalRelaxation {
   static constexpr int kMaxSeeds = 32;
 
  private:
-  /// The dofs of the patch around `seeds` (nodes: first local dof / dim), into cells_, free_.
+  /// The cells and free dofs of the patch around `seeds` (nodes: first local dof / dim) into cells_, free_.
   void patch(const std::vector<PetscInt>& seeds, const PetscScalar* fixed);
   /// R on free_ at u (the patch's cells only) into rf; false where u is inadmissible.
   bool patch_residual(Vec u, double s, std::vector<double>& rf);
