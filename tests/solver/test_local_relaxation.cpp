@@ -13,6 +13,7 @@
 
 using namespace hypershape;
 
+namespace test_local_relaxation {  // (unity builds: helper names of its own)
 namespace {
 
 core::VecH copy_of(Vec v) {
@@ -132,3 +133,5 @@ TEST_CASE("Local relaxation takes a node pushed off an equilibrium back to it on
     CHECK(a[2 * (n / 4)] == b[2 * (n / 4)]);
   }
 }
+
+}  // namespace test_local_relaxation
