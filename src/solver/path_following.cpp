@@ -118,7 +118,6 @@ bool NonlinearSolver::relax_patch(PetscReal& rn) {
   if (size > 1) return false;
   if (!relaxation_) relaxation_ = std::make_unique<LocalRelaxation>(problem_);
   const LocalRelaxation::Result res = relaxation_->relax(u_, s_, r_, c_);
-  relaxation_steps_ += res.iterations;
   if (!res.relaxed) return false;
   if (!residual_at(u_, s_, r_)) throw std::logic_error("a relaxed state is inadmissible");
   HS_PETSC(VecNorm(r_, NORM_2, &rn));

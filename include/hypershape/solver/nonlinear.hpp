@@ -458,7 +458,6 @@ class NonlinearSolver {
   double arc_offset_ = 0;    ///< arc_dir_ . u at the increment's start
   std::vector<PetscInt> global_of_local_;  ///< see global_of_local()
   std::unique_ptr<LocalRelaxation> relaxation_;  ///< relax_patch's (made at its first use)
-  long relaxation_steps_ = 0;  ///< local Newton steps of relax_patch
   double s_ = 0;        ///< load factor of the current state
   double s_eval_ = 0;   ///< load factor the callbacks assemble at
   /// The stored energy and internal force of the last trial backtrack evaluated (NaN: none),
