@@ -369,7 +369,7 @@ class NonlinearSolver {
   bool correct(double d, double rtol, int& its, std::string& why);
   /// SolverOptions::local_relaxation: relaxes u_ on the patch where R (in r_) sits
   /// (LocalRelaxation); where it did, r_ and `rn` are the relaxed state's. One rank,
-  /// conservative problems, a direct factor.
+  /// conservative problems, not with multigrid.
   bool relax_patch(PetscReal& rn);
   /// With abandon_off_path: whether a corrector iterate of an intermediate increment (`rtol` above
   /// the final one), on the increment's first try, has left the path: its tangent has more
