@@ -106,14 +106,14 @@ void LocalRelaxation::patch(const std::vector<PetscInt>& seeds, const PetscScala
     }
 }
 
-bool LocalRelaxation::patch_residual(Vec u, double s, std::vector<double>& rf) {
+bool LocalRelaxation::patch_residual(Vec u, double s, Eigen::VectorXd& rf) {
   {
     physics::CellSubset only(problem_.space(), cells_);
     if (!problem_.residual(u, s, work_)) return false;
   }
   core::VecArray<const PetscScalar> r(work_);
-  rf.resize(free_.size());
-  for (std::size_t i = 0; i < free_.size(); ++i) rf[i] = r[free_[i]];
+  rf.resize(Eigen::Index(free_.size()));
+  for (std::size_t i = 0; i < free_.size(); ++i) rf[Eigen::Index(i)] = r[free_[i]];
   return true;
 }
 
@@ -153,9 +153,8 @@ LocalRelaxation::Result LocalRelaxation::relax(Vec u, double s, Vec r, Vec fixed
   out.dofs = int(nf);
   if (nf == 0) return out;
   // The goal: a tenth of the residual outside the patch, or a hundredth of the patch's own.
-  std::vector<double> rf;
-  if (!patch_residual(u, s, rf)) return out;
-  Eigen::Map<Eigen::VectorXd> rv(rf.data(), nf);
+  Eigen::VectorXd rv;
+  if (!patch_residual(u, s, rv)) return out;
   out.before = out.after = rv.norm();
   const double outside = std::sqrt(std::max(total - rv.squaredNorm(), 0.0));
   const double goal = std::max(0.1 * outside, 1e-2 * out.before);
@@ -166,6 +165,7 @@ LocalRelaxation::Result LocalRelaxation::relax(Vec u, double s, Vec r, Vec fixed
   Eigen::SparseMatrix<double> K(nf, nf);
   Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
   std::vector<Eigen::Triplet<double>> entries;
+  double e0 = NAN;  // the patch's energy at u: the accepted trial's after the first step
   for (; out.iterations < kMaxSteps && out.after > goal; ++out.iterations) {
     {
       physics::CellSubset only(problem_.space(), cells_);
@@ -197,8 +197,7 @@ LocalRelaxation::Result LocalRelaxation::relax(Vec u, double s, Vec r, Vec fixed
     if (llt.info() != Eigen::Success) break;
     const Eigen::VectorXd d = -llt.solve(rv);
     const double slope = rv.dot(d);
-    double e0;
-    if (!(slope < 0) || !patch_energy(u, s, e0)) break;
+    if (!(slope < 0) || (std::isnan(e0) && !patch_energy(u, s, e0))) break;
     double lambda = 1.0, e = 0;
     for (; lambda > 1e-6; lambda *= 0.5) {
       HS_PETSC(VecCopy(u, trial_));
@@ -210,8 +209,9 @@ LocalRelaxation::Result LocalRelaxation::relax(Vec u, double s, Vec r, Vec fixed
     }
     if (!(lambda > 1e-6)) break;
     HS_PETSC(VecCopy(trial_, u));
+    e0 = e;
     out.relaxed = true;
-    if (!patch_residual(u, s, rf)) break;  // (admissible: its energy was finite)
+    if (!patch_residual(u, s, rv)) break;  // (admissible: its energy was finite)
     out.after = rv.norm();
   }
   return out;

@@ -10,6 +10,7 @@
 #include <petscmat.h>
 #include <petscvec.h>
 
+#include <Eigen/Core>
 #include <vector>
 
 #include "hypershape/core/petsc_handle.hpp"
@@ -46,7 +47,7 @@ class LocalRelaxation {
   /// The cells and free dofs of the patch around `seeds` (nodes: first local dof / dim) into cells_, free_.
   void patch(const std::vector<PetscInt>& seeds, const PetscScalar* fixed);
   /// R on free_ at u (the patch's cells only) into rf; false where u is inadmissible.
-  bool patch_residual(Vec u, double s, std::vector<double>& rf);
+  bool patch_residual(Vec u, double s, Eigen::VectorXd& rf);
   /// The energy at u with the patch's cells only (the rest is constant); false if inadmissible.
   bool patch_energy(Vec u, double s, double& e);
 
