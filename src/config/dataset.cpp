@@ -411,16 +411,18 @@ void parse_mesh(const YamlBlock& top, const std::string& source, DatasetConfig& 
   }
   if (m.has("rim")) {
     const double rim = m.number("rim");
-    if (c.shapes.dim != 3)
-      m.fail("rim", "only for 3D shapes (2D: the patch ends are vertices of the boundary, its spacing "
-                    "there set by curvature and shapes.h)");
     if (!(rim > 0 && rim <= std::max(c.shapes.h, c.shapes.mesh_h)))
-      m.fail("rim", "must be in (0, mesh.h] (edge length at the clamp rim)");
+      m.fail("rim", fmt::format("must be in (0, {:g}] (edge length at the clamp rim, 2D: at the patch ends; "
+                                "at most {})", std::max(c.shapes.h, c.shapes.mesh_h),
+                                c.shapes.dim == 2 ? "shapes.h" : "mesh.h"));
+    if (c.shapes.dirichlet_radius <= 0 && (c.shapes.dim == 3 || c.shapes.fixed_supports.empty()))
+      m.fail("rim", c.shapes.dim == 3 ? "needs a Dirichlet patch (shapes.dirichlet_radius > 0)"
+                                      : "needs a Dirichlet patch or region (shapes.dirichlet_radius > 0, or dirichlet effects)");
     c.shapes.rim_size = rim;
   }
   m.allowed("degree, quadrature (exactness of the cell rule), h (3D: mesh edge length when coarser than "
-            "shapes.h), surface_h (3D: surface edge length, shapes.h keeps it as drawn), rim (3D: edge length "
-            "at the clamp rim)");
+            "shapes.h), surface_h (3D: surface edge length, shapes.h keeps it as drawn), rim (edge length at "
+            "the clamp rim; 2D: at the patch ends)");
   m.check_all_used();
 }
 

@@ -273,10 +273,20 @@ ShapeSample make_shape(const ShapeConfig& config, const std::optional<geometry::
       }
       out.quality = mesh::mesh_quality(out.mesh);
       if (std::string why; !mesh::passes(out.quality, gate, &why)) throw Rejection{"quality", why};
-      const double t2 = core::now_seconds();
       out.attempt = attempt;
       out.dirichlet_radius = config.dirichlet_radius;
       out.dirichlet_facets = dirichlet_facets(config, out);
+      if (config.dim == 2 && config.rim_size > 0) {
+        try {
+          out = grade_shape(out, mopt.h, config.rim_size, config.size_grading);
+        } catch (const std::runtime_error& e) {
+          throw Rejection{"mesh", fmt::format("graded to the rim {:g}: {}", config.rim_size, e.what())};
+        }
+        out.quality = mesh::mesh_quality(out.mesh);
+        if (std::string why; !mesh::passes(out.quality, gate, &why))
+          throw Rejection{"quality", fmt::format("graded to the rim {:g}: {}", config.rim_size, why)};
+      }
+      const double t2 = core::now_seconds();
       const geometry::Boundary ref = reference_base(config, base);
       // Hausdorff accuracy (3D only): h / 8, i.e. 1.25% of the box half-width at h = 0.1.
       out.metrics = geometry::compute_metrics(out.boundary, &ref, config.h / (config.dim == 2 ? 20 : 8));

@@ -235,3 +235,44 @@ TEST_CASE("a 3D mesh coarser than its shape (mesh_h): same draw, surface remeshe
   CHECK(geometry::enclosed_measure(coarse.boundary) ==
         Approx(geometry::enclosed_measure(fine.boundary)).epsilon(0.05));
 }
+
+TEST_CASE("a 2D rim grades the mesh towards the patch ends: the same polygon, the ends resolved at the rim",
+          "[factory][shapes]") {
+  const auto cfg = preset("random2d");  // P2 at h 0.12: its boundary spacing at the ends is ~0.03-0.12
+  const double rim = 0.01;
+  auto fine = cfg.shapes;
+  fine.rim_size = rim;
+  for (std::int64_t id : {0, 3}) {
+    INFO("shape " << id);
+    const auto a = factory::make_shape(cfg.shapes, std::nullopt, cfg.seed, id);
+    const auto b = factory::make_shape(fine, std::nullopt, cfg.seed, id);
+    check_shape(b, fine);
+    // The same draw and the same polygon: every drawn point kept, the rest on its facets.
+    CHECK(b.attempt == a.attempt);
+    CHECK(b.dirichlet_center == a.dirichlet_center);
+    CHECK(geometry::enclosed_measure(b.boundary) == Approx(geometry::enclosed_measure(a.boundary)).epsilon(1e-12));
+    std::set<std::pair<double, double>> drawn;
+    for (std::int64_t i = 0; i < b.boundary.n_points(); ++i) drawn.insert({b.boundary.point(i)[0], b.boundary.point(i)[1]});
+    for (std::int64_t i = 0; i < a.boundary.n_points(); ++i)
+      CHECK(drawn.count({a.boundary.point(i)[0], a.boundary.point(i)[1]}) == 1);
+    // Both boundary edges at every clamp end are about the rim (the drawn ones were longer).
+    auto end_edges = [](const factory::ShapeSample& s) {
+      std::vector<double> out;
+      const auto ends = factory::clamp_ends(s);
+      const auto& bd = s.boundary;
+      for (std::int64_t f = 0; f < bd.n_facets(); ++f) {
+        const auto v = bd.facet(f);
+        const auto p = bd.point(v[0]), q = bd.point(v[1]);
+        for (const auto& e : ends)
+          if ((p[0] == e[0] && p[1] == e[1]) || (q[0] == e[0] && q[1] == e[1]))
+            out.push_back(std::hypot(q[0] - p[0], q[1] - p[1]));
+      }
+      return out;
+    };
+    const auto ea = end_edges(a), eb = end_edges(b);
+    REQUIRE(eb.size() >= 4);
+    CHECK(*std::max_element(eb.begin(), eb.end()) <= 1.5 * rim);
+    CHECK(*std::max_element(ea.begin(), ea.end()) > 2 * rim);
+    CHECK(b.mesh.n_cells() > a.mesh.n_cells());
+  }
+}

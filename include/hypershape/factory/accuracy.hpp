@@ -59,22 +59,6 @@ inline bool exceeds(const config::AccuracyConfig& a, double rel_l2) { return rel
 /// collective.
 ShapeSample refine_shape(const ShapeSample& shape);
 
-/// 2D: the points where a Dirichlet region of `shape` ends (a boundary point on exactly one
-/// Dirichlet facet), where u is singular.
-std::vector<std::array<double, 2>> clamp_ends(const ShapeSample& shape);
-
-/// 2D: `shape` meshed again, graded towards its clamp ends: the polygon's facets split (points
-/// added on them, none moved) to about end_size + growth * (distance to the nearest end), at most
-/// h, and the inside meshed from that boundary (mesh::mesh_boundary). The polygon, p_D and the
-/// Dirichlet facets' union are unchanged. Not collective.
-///
-/// Measured and not on the ladder (docs/ACCURACY.md, "Random2D at P2, and a mesh graded towards the
-/// clamp ends"): `study_error_estimate --graded` on Random2D P2 h 0.08: end_size h / 8 cut the true
-/// error by a median 25% (14 load cases), h / 32 by 1.9-3.7x on 5 of 6, for 1.3x and 3-5x the
-/// Newton iterations; the one-step estimate undershoots on those meshes (the ladder chooses by it).
-ShapeSample grade_shape(const ShapeSample& shape, double h, double end_size, double growth);
-inline constexpr double kGradeGrowth = 0.3;  ///< study_error_estimate --graded: size growth per unit distance
-
 /// What the accuracy ladder did over a set of shapes (a shape's job, a run report).
 struct AccuracySummary {
   static constexpr int kLevels = 4;

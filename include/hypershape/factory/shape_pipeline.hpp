@@ -43,8 +43,10 @@ struct ShapeConfig {
   /// the surface as drawn (its detail in the stored boundary, SDF and point cloud) while the
   /// interior still grows (size_grading per unit distance) to mesh_h.
   double surface_h = 0.0;
-  /// 3D: edge length at the clamp rim |x - p_D| = r (0: not refined), growing by size_grading
-  /// per unit distance (geometry::RemeshOptions::size): the rim is where the error lives.
+  /// Edge length at the clamp rim (0: not refined), growing by size_grading per unit distance:
+  /// the rim is where the error lives. 3D: the rim |x - p_D| = r of the remeshed surface
+  /// (geometry::RemeshOptions::size). 2D: the ends of every Dirichlet region, the drawn polygon's
+  /// facets split there (grade_shape: the polygon, and so the problem, unchanged).
   double rim_size = 0.0;
   double dirichlet_radius = 0.5;         ///< r of the Dirichlet patch; 0: no patch
   /// Fixed Dirichlet regions besides the drawn patch (a dataset's `dirichlet` effects): each
@@ -105,6 +107,18 @@ geometry::Boundary reference_base(const ShapeConfig& config,
 /// The name (without directory) of the surface file shape `shape_id` is made of (base ==
 /// directory), or "" for the other families.
 std::string source_file(const ShapeConfig& config, std::int64_t shape_id);
+
+/// 2D: the points where a Dirichlet region of `shape` ends (a boundary point on exactly one
+/// Dirichlet facet), where u is singular.
+std::vector<std::array<double, 2>> clamp_ends(const ShapeSample& shape);
+
+/// 2D: `shape` meshed again, graded towards its clamp ends: the polygon's facets split (points
+/// added on them, none moved) to about end_size + growth * (distance to the nearest end), at most
+/// h, and the inside meshed from that boundary (mesh::mesh_boundary). The polygon, p_D and the
+/// Dirichlet facets' union are unchanged: the same boundary-value problem, discretised finer
+/// where its error lives (FACTS.md). Not collective. make_shape applies it for `rim_size`.
+ShapeSample grade_shape(const ShapeSample& shape, double h, double end_size, double growth);
+inline constexpr double kGradeGrowth = 0.3;  ///< study_error_estimate --graded: size growth per unit distance
 
 /// Draws shape `shape_id` of the family. `base` is load_base(config); a directory family reads
 /// its shape's own file here. Throws std::runtime_error if max_attempts draws all fail (with
