@@ -31,8 +31,10 @@ int main(int argc, char** argv) {
   app.add_option("--degree", o.degree, "element degree (default: the preset's)")->check(CLI::IsMember({1, 2}));
   app.add_option("--h", o.h, "element size (default: the preset's)")->check(CLI::PositiveNumber);
   app.add_option("--levels", o.levels, "reference refinements (default 2 in 2D, 1 in 3D)")->check(CLI::Range(1, 3));
-  app.add_option("--graded", o.graded, "2D random shapes: a mesh graded towards the clamp ends, this x h there (e.g. 0.125)")
-      ->check(CLI::Range(1e-3, 1.0));
+  app.add_option("--graded", o.graded,
+                 "2D random shapes: the mesh graded towards the clamp ends, this x h there (mesh.rim; e.g. 0.03125, "
+                 "the random2d preset's; 0: not graded; default: the preset's own)")
+      ->check(CLI::Range(0.0, 1.0));
   app.add_flag("--fine-newton", o.fine_newton, "the estimate's fine Newton to 1% of its first residual, not one step");
   bool estimate_only = false;
   app.add_flag("--estimate-only", estimate_only, "no references: solve and estimate only (the estimate's cost and values)");

@@ -2,7 +2,7 @@
 # The validation of the labels' error estimate in docs/ACCURACY.md ("Every label knows its own
 # error"): build/study_error_estimate on the accuracy study's scenes and on random Random2D /
 # Random3D load cases, then scripts/error_estimate_report.py (table + log-log plot).
-#   scripts/error_estimate_study.sh [PART...]    parts: random2d scenes2d p2 random2d_p2 easy_random2d_p2 graded random3d random3d_h03 scenes3d report
+#   scripts/error_estimate_study.sh [PART...]    parts: random2d scenes2d p2 random2d_p2 easy_random2d_p2 graded random2d_rim random3d random3d_h03 scenes3d report
 #                                                (default: all; each appends to docs/error_estimate/PART.jsonl)
 # One rank, OPENBLAS_NUM_THREADS=1; references with MUMPS (-ref_ prefix). Runtime on the shared
 # 2-core VM: random2d ~10 min, scenes2d ~5, p2 ~10, random3d/scenes3d ~10 each.
@@ -38,6 +38,13 @@ for part in "${parts[@]}"; do
         --out "$OUT/graded/random2d_p2_fine_newton_estimate_only.jsonl"
       "$BIN" --preset random2d_p1 --degree 2 --h 0.08 --graded 0.125 --shapes $(seq 20 27) --loads 2 --fine-newton \
         --estimate-only --out "$OUT/graded/random2d_p2_graded0.125_fine_newton_estimate_only.jsonl" ;;
+    random2d_rim)  # the random2d preset's mesh graded to h/32 at the clamp ends (mesh.rim 0.00375, since
+                   # 2026-11-29) against the same mesh ungraded (the preset before) and at h/16: shapes 20-27
+      mkdir -p "$OUT/rim"
+      "$BIN" --preset random2d --shapes $(seq 20 27) --loads 2 --out "$OUT/rim/random2d.jsonl" -- "${ref[@]}"
+      for g in 0 0.0625; do
+        "$BIN" --preset random2d --graded $g --shapes $(seq 20 27) --loads 2 --out "$OUT/rim/random2d_graded$g.jsonl" -- "${ref[@]}"
+      done ;;
     random3d)  # Random3D shapes (P2) as the preset solves them, coarser (mesh.h 0.5) so that a
                # reference two refinements finer stays within reach of one core
       "$BIN" --preset random3d --h 0.5 --shapes 0 1 2 3 4 --loads 2 --levels 2 --out "$OUT/random3d.jsonl" -- "${ref[@]}" ;;

@@ -197,9 +197,10 @@ void run_estimate_study(const EstimateStudyOptions& o, std::ostream& out) {
   const int d = cfg.shapes.dim;
   if (o.h > 0) (d == 3 && cfg.shapes.mesh_h > 0 ? cfg.shapes.mesh_h : cfg.shapes.h) = o.h;
   const int n_levels = !o.references ? 0 : o.levels > 0 ? o.levels : (d == 2 ? 2 : 1);
-  if (o.graded > 0 && (d != 2 || !o.scene.empty())) throw std::invalid_argument("--graded: 2D random shapes only");
+  if (o.graded >= 0 && (d != 2 || !o.scene.empty())) throw std::invalid_argument("--graded: 2D random shapes only");
+  if (o.graded >= 0) cfg.shapes.rim_size = o.graded * cfg.shapes.h;  // made by make_shape, as the factory does
   const std::string label = fmt::format("{}-P{}-h{:g}{}{}", o.scene.empty() ? o.preset : o.scene, cfg.degree,
-                                        accuracy::preset_mesh_h(cfg), o.graded > 0 ? fmt::format("-graded{:g}", o.graded) : "",
+                                        accuracy::preset_mesh_h(cfg), o.graded >= 0 ? fmt::format("-graded{:g}", o.graded) : "",
                                         o.fine_newton ? "-fine-newton" : "");
   if (!o.scene.empty()) {
     const double h = accuracy::preset_mesh_h(cfg);
@@ -216,8 +217,7 @@ void run_estimate_study(const EstimateStudyOptions& o, std::ostream& out) {
   }
   const auto base = factory::load_base(cfg.shapes);
   for (std::int64_t id : o.shapes) {
-    auto shape = factory::make_shape(factory::shape_config(cfg, id), base, cfg.seed, id);
-    if (o.graded > 0) shape = factory::grade_shape(shape, cfg.shapes.h, o.graded * cfg.shapes.h, factory::kGradeGrowth);
+    const auto shape = factory::make_shape(factory::shape_config(cfg, id), base, cfg.seed, id);
     auto cases = factory::draw_load_cases(shape, cfg.loads, cfg.seed, factory::n_tractions(cfg));
     cases.resize(std::size_t(std::min<int>(o.loads, int(cases.size()))));
     run_shape(cfg, shape, cases, n_levels, o.fine_newton, label, out);

@@ -118,7 +118,6 @@ std::vector<std::array<double, 2>> clamp_ends(const ShapeSample& shape);
 /// Dirichlet facets' union are unchanged: the same boundary-value problem, discretised finer
 /// where its error lives (FACTS.md). Not collective. make_shape applies it for `rim_size`.
 ShapeSample grade_shape(const ShapeSample& shape, double h, double end_size, double growth);
-inline constexpr double kGradeGrowth = 0.3;  ///< study_error_estimate --graded: size growth per unit distance
 
 /// Draws shape `shape_id` of the family. `base` is load_base(config); a directory family reads
 /// its shape's own file here. Throws std::runtime_error if max_attempts draws all fail (with

@@ -19,7 +19,7 @@ struct EstimateStudyOptions {
   int degree = 0;                      ///< 0: the preset's
   double h = 0;                        ///< 0: the preset's (2D shapes.h, 3D mesh.h)
   int levels = 0;                      ///< reference refinements (0: 2 in 2D, 1 in 3D)
-  double graded = 0;                   ///< > 0, 2D random shapes: meshed graded towards the clamp ends, this x h there (factory::grade_shape)
+  double graded = -1;                  ///< >= 0, 2D random shapes: mesh.rim = graded x h (0: not graded); < 0: the preset's own
   bool fine_newton = false;            ///< the estimate's fine Newton to tolerance (as for the mean-dilatation element)
   bool references = true;              ///< false: solve and estimate only (no truth; cost and estimate comparisons)
 };
