@@ -411,13 +411,12 @@ void parse_mesh(const YamlBlock& top, const std::string& source, DatasetConfig& 
   }
   if (m.has("rim")) {
     const double rim = m.number("rim");
-    if (!(rim > 0 && rim <= std::max(c.shapes.h, c.shapes.mesh_h)))
-      m.fail("rim", fmt::format("must be in (0, {:g}] (edge length at the clamp rim, 2D: at the patch ends; "
-                                "at most {})", std::max(c.shapes.h, c.shapes.mesh_h),
+    // Without a Dirichlet region there is nothing to grade: the key is then without effect (a
+    // preset's rim stays valid under a config that drops the patch).
+    if (!(rim >= 0 && rim <= std::max(c.shapes.h, c.shapes.mesh_h)))
+      m.fail("rim", fmt::format("must be in [0, {:g}] (edge length at the clamp rim, 2D: at the patch ends; "
+                                "at most {}; 0: not graded)", std::max(c.shapes.h, c.shapes.mesh_h),
                                 c.shapes.dim == 2 ? "shapes.h" : "mesh.h"));
-    if (c.shapes.dirichlet_radius <= 0 && (c.shapes.dim == 3 || c.shapes.fixed_supports.empty()))
-      m.fail("rim", c.shapes.dim == 3 ? "needs a Dirichlet patch (shapes.dirichlet_radius > 0)"
-                                      : "needs a Dirichlet patch or region (shapes.dirichlet_radius > 0, or dirichlet effects)");
     c.shapes.rim_size = rim;
   }
   m.allowed("degree, quadrature (exactness of the cell rule), h (3D: mesh edge length when coarser than "

@@ -119,7 +119,10 @@ Scene parse_scene_text(const std::string& text, const std::string& source, const
   for (const char* key : {"surface_h", "rim"}) {
     if (!mesh.has(key)) continue;
     const double v = mesh.number(key);
-    if (s.dim != 3 || s.base != "sphere") mesh.fail(key, "only for geometry {base: sphere} (the datasets' 3D keys)");
+    const bool disk_rim = s.dim == 2 && s.base == "circle" && std::string(key) == "rim";
+    if (!disk_rim && (s.dim != 3 || s.base != "sphere"))
+      mesh.fail(key, std::string(key) == "rim" ? "only for geometry {base: sphere} or {base: circle} (the datasets' key)"
+                                                : "only for geometry {base: sphere} (the datasets' 3D key)");
     if (!(v > 0 && v <= 1)) mesh.fail(key, "must be in (0, 1] (an edge length)");
     (std::string(key) == "rim" ? s.rim_size : s.surface_h) = v;
   }

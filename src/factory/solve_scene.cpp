@@ -147,7 +147,8 @@ SceneOutcome solve_scene(MPI_Comm comm, const config::Scene& scene_in, const Sce
     if (scene.base != "file") {
       mesh::MeshOptions mo;
       mo.h = scene.h;
-      mo.clamp_size = scene.h * scene.clamp_refinement;
+      // 2D: mesh.rim (the datasets' key) is the size at the patch ends itself.
+      mo.clamp_size = scene.dim == 2 && scene.rim_size > 0 ? scene.rim_size : scene.h * scene.clamp_refinement;
       auto clamp = clamp_of(resolved, scene.dim);
       core::on_root(comm, [&] {
         m = scene.base == "polygon"                         ? mesh::mesh_polygon(scene.polygon, scene.h)

@@ -94,9 +94,8 @@ bad types predictor_word 2 "solver.predictor: must be second_order or tangent" "
 bad types corrector_word 2 "solver.corrector: must be chebyshev" "$(add 'solver: {corrector: halley}')"
 bad types relax_word     2 "solver.local_relaxation: must be true or false" "$(add 'solver: {local_relaxation: sometimes}')"
 bad types r3_finer_mesh  2 "mesh.surface_h: must be in [shapes.h = 0.1, mesh.h = 0.2]" "$(sub 's/^preset: random2d/preset: random3d/; s/shapes: {count: 2, h: 0.2}/shapes: {count: 1}\nmesh: {h: 0.2}/')"
-bad types rim_2d_coarse   2 "mesh.rim: must be in (0, 0.2] (edge length at the clamp rim, 2D: at the patch ends; at most shapes.h)" "$(add 'mesh: {rim: 0.3}')"
-bad types rim_no_patch   2 "mesh.rim: needs a Dirichlet patch" "$(sub 's/shapes: {count: 2, h: 0.2}/shapes: {count: 2, h: 0.2, dirichlet_radius: 0}/')
-mesh: {rim: 0.05}"
+bad types rim_2d_coarse   2 "mesh.rim: must be in [0, 0.2] (edge length at the clamp rim, 2D: at the patch ends; at most shapes.h; 0: not graded)" "$(add 'mesh: {rim: 0.3}')"
+bad types rim_negative   2 "mesh.rim: must be in [0, 0.2]" "$(add 'mesh: {rim: -0.01}')"
 bad types linear_word     2 "solver.linear: must be auto, direct, gamg or hypre" "$(add 'solver: {linear: amg}')"
 
 # ---- sizes -------------------------------------------------------------------------------------

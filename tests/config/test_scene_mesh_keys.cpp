@@ -37,6 +37,7 @@ TEST_CASE("every preset's mesh block is a valid scene mesh block", "[config]") {
     REQUIRE_NOTHROW(s = config::parse_scene_text(scene_text, "<test>"));
     CHECK(s.degree == cfg.degree);
     if (cfg.shapes.mesh_h > 0) CHECK(s.h == cfg.shapes.mesh_h);
+    CHECK(s.rim_size == cfg.shapes.rim_size);
     ++n_checked;
   }
   CHECK(n_checked >= 6);  // the four 3D presets and the two 2D ones with a mesh block

@@ -43,7 +43,8 @@ struct Scene {
   /// 3D sphere: the datasets' discretisation keys (factory::ShapeConfig::surface_h, rim_size).
   /// With either set, the ball is meshed as the factory meshes a shape (a fine icosphere
   /// remeshed at surface_h, h when 0, with the clamp curve and the rim refinement, then filled
-  /// up to h) instead of by gmsh's sphere with clamp_refinement.
+  /// up to h) instead of by gmsh's sphere with clamp_refinement. 2D circle: rim_size is the size
+  /// at the patch ends (instead of h * clamp_refinement).
   double surface_h = 0, rim_size = 0;
   physics::SceneSpec effects;  ///< in file order; numbers only (no draws in a scene file)
   std::optional<double> alpha, target;
