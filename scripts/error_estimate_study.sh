@@ -2,7 +2,7 @@
 # The validation of the labels' error estimate in docs/ACCURACY.md ("Every label knows its own
 # error"): build/study_error_estimate on the accuracy study's scenes and on random Random2D /
 # Random3D load cases, then scripts/error_estimate_report.py (table + log-log plot).
-#   scripts/error_estimate_study.sh [PART...]    parts: random2d scenes2d p2 random2d_p2 easy_random2d_p2 graded random2d_rim random3d random3d_h03 scenes3d report
+#   scripts/error_estimate_study.sh [PART...]    parts: random2d scenes2d p2 random2d_p2 easy_random2d_p2 graded random2d_rim easy_random2d_rim random3d random3d_h03 scenes3d report
 #                                                (default: all; each appends to docs/error_estimate/PART.jsonl)
 # One rank, OPENBLAS_NUM_THREADS=1; references with MUMPS (-ref_ prefix). Runtime on the shared
 # 2-core VM: random2d ~10 min, scenes2d ~5, p2 ~10, random3d/scenes3d ~10 each.
@@ -44,6 +44,11 @@ for part in "${parts[@]}"; do
       "$BIN" --preset random2d --shapes $(seq 20 27) --loads 2 --out "$OUT/rim/random2d.jsonl" -- "${ref[@]}"
       for g in 0 0.0625; do
         "$BIN" --preset random2d --graded $g --shapes $(seq 20 27) --loads 2 --out "$OUT/rim/random2d_graded$g.jsonl" -- "${ref[@]}"
+      done ;;
+    easy_random2d_rim)  # the same for easy_random2d (not graded: its preset; h/32)
+      mkdir -p "$OUT/rim"
+      for g in 0 0.03125; do
+        "$BIN" --preset easy_random2d --graded $g --shapes $(seq 20 27) --loads 2 --out "$OUT/rim/easy_random2d_graded$g.jsonl" -- "${ref[@]}"
       done ;;
     random3d)  # Random3D shapes (P2) as the preset solves them, coarser (mesh.h 0.5) so that a
                # reference two refinements finer stays within reach of one core
