@@ -45,9 +45,9 @@ for part in "${parts[@]}"; do
       for g in 0 0.0625; do
         "$BIN" --preset random2d --graded $g --shapes $(seq 20 27) --loads 2 --out "$OUT/rim/random2d_graded$g.jsonl" -- "${ref[@]}"
       done ;;
-    easy_random2d_rim)  # the same for easy_random2d (not graded: its preset; h/32)
+    easy_random2d_rim)  # the same for easy_random2d (not graded: its preset; h/16, h/32)
       mkdir -p "$OUT/rim"
-      for g in 0 0.03125; do
+      for g in 0 0.0625 0.03125; do
         "$BIN" --preset easy_random2d --graded $g --shapes $(seq 20 27) --loads 2 --out "$OUT/rim/easy_random2d_graded$g.jsonl" -- "${ref[@]}"
       done ;;
     random3d)  # Random3D shapes (P2) as the preset solves them, coarser (mesh.h 0.5) so that a
