@@ -126,6 +126,8 @@ Scene parse_scene_text(const std::string& text, const std::string& source, const
     if (!(v > 0 && v <= 1)) mesh.fail(key, "must be in (0, 1] (an edge length)");
     (std::string(key) == "rim" ? s.rim_size : s.surface_h) = v;
   }
+  if (s.dim == 2 && mesh.has("rim") && mesh.has("clamp_refinement"))
+    mesh.fail("rim", "give one of rim (the size at the patch ends) and clamp_refinement (that size / h)");
   mesh.allowed("h, degree, clamp_refinement, surface_h, rim");
   mesh.check_all_used();
 

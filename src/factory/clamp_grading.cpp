@@ -1,6 +1,4 @@
 // Meshes graded towards the ends of a 2D shape's Dirichlet regions, where u is singular.
-#include <fmt/format.h>
-
 #include <algorithm>
 #include <cmath>
 #include <functional>

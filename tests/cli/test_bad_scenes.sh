@@ -49,7 +49,17 @@ expect spring_both_forms 's/^load:/  spring: {stiffness: 1, tangential_stiffness
 expect inclusions_no_ratio 's/nu: 0.49}/nu: 0.49, inclusions: 2, inclusion_radius: 0.2}/' 'effects.neo_hookean.inclusion_ratio'
 expect inclusions_fraction 's/nu: 0.49}/nu: 0.49, inclusions: 1.5, inclusion_radius: 0.2, inclusion_ratio: 3}/' 'effects.neo_hookean.inclusions'
 expect step_growth_below_1 's/^load: {target: 0.3}/load: {target: 0.3}\nsolver: {step_growth: 0.5}/' 'solver.step_growth'
+expect rim_and_refinement 's/h: 0.1, degree: 1/h: 0.1, degree: 1, rim: 0.01, clamp_refinement: 0.25/' 'mesh.rim'
+expect rim_on_polygon    's/{base: circle}/{polygon: [[0, 0], [1, 0], [0, 1]]}/; s/degree: 1/degree: 1, rim: 0.01/' 'mesh.rim'
 expect not_yaml          's/^geometry: {base: circle}/geometry: {base: [circle/' 'YAML'
+
+# The datasets' 2D mesh.rim sets the mesh size at the patch ends (instead of h x clamp_refinement):
+# finer than the default quarter of h, the mesh has more vertices.
+verts() { good | sed -e "$1" > "$work/v.yaml"; "$bin" solve "$work/v.yaml" -o "$work/v.h5" 2>/dev/null | grep -o '[0-9]* vertices' | cut -d' ' -f1; }
+n_default=$(verts 's/x/x/') n_rim=$(verts 's/degree: 1/degree: 1, rim: 0.004/')
+if [ -n "$n_default" ] && [ -n "$n_rim" ] && [ "$n_rim" -gt "$n_default" ]; then
+  echo "ok   2D rim 0.004: $n_rim vertices against $n_default (clamp_refinement 0.25)"; passes=$((passes+1))
+else echo "FAIL 2D rim: '$n_rim' vertices against '$n_default'"; fails=$((fails+1)); fi
 
 # An unwritable output directory: rejected before any work.
 good > "$work/ok.yaml"
