@@ -17,12 +17,15 @@ std::string fmt_g(double v) { return fmt::format("{:g}", v); }
 
 config::DatasetConfig scene_config(const SceneSpec& s, const std::string& override_yaml) {
   // The study refines uniformly with the seed's pointwise material: the random3d preset's clamp
-  // rim and mean dilatation (since 2026-11-25) are measured by study_labels3d instead.
+  // rim and mean dilatation (since 2026-11-25) are measured by study_labels3d instead, and the 2D
+  // presets' grading at the patch ends (mesh.rim, since 2026-11-29) by study_error_estimate
+  // (one absolute rim at every h would not be a uniform refinement).
   const bool r3 = s.preset == "random3d" && override_yaml.find("material") == std::string::npos;
   auto c = config::parse_dataset_text("preset: " + s.preset + "\n" + override_yaml + "\n" +
                                           (r3 ? "material: {dilatation: pointwise}\n" : ""),
                                       "<study_accuracy --override>");
-  if (s.preset == "random3d") c.shapes.rim_size = 0, c.shapes.surface_h = 0;
+  c.shapes.rim_size = 0;
+  if (s.preset == "random3d") c.shapes.surface_h = 0;
   return c;
 }
 

@@ -30,9 +30,12 @@
 # On 2026-11-29 the random2d preset's mesh was graded to 0.00375 at the patch ends (mesh.rim,
 # issue 15): preset_r2p.yaml now writes the former preset out (random2d_p1 at P2 h 0.12: only
 # its stored config text was updated), and preset_r2g is the preset itself, fingerprinted then.
+# Later that day easy_random2d was graded to 0.0075 at the patch ends: preset_e2.yaml writes the
+# former preset out (`mesh: {rim: 0}`: only its stored config text was updated), and preset_e2g
+# is the preset itself.
 # Needs HYPERSHAPE_BIN and HYPERSHAPE_SOURCE_DIR (set by CTest).
 . "$(dirname "$0")/lib.sh"
-for name in r2 r2p r2g e2 r3 r3m r3s; do
+for name in r2 r2p r2g e2 e2g r3 r3m r3s; do
   cfg="$src/tests/cli/expected/preset_$name.yaml"
   "$bin" -q generate "$cfg" --progress 0 -o "$work/$name" || { fail "$name: generate"; continue; }
   if out=$(/usr/bin/python3 "$src/tests/cli/dataset_fingerprint.py" "$work/$name" \
