@@ -3,6 +3,10 @@
 lines of study_error_estimate (scripts/error_estimate_study.sh):
 
   error_estimate_report.py docs/error_estimate/*.jsonl [--plot docs/figures/error_estimate.png]
+  error_estimate_report.py ESTIMATE_ONLY.jsonl --truths docs/error_estimate/*.jsonl
+
+(--truths: the true errors of `study_error_estimate --estimate-only` runs, taken from the runs with
+references of the same cases: case label, shape, load and target alike)
 
 prints a markdown table per case family (label: scene or preset, degree, h) and over all:
 effectivity index estimate / true of the relative L2 error of u (and |max|u|| and |alpha|
@@ -17,15 +21,25 @@ import numpy as np
 QUANTITIES = (("rel_l2", "relative L2 of u"), ("max_u", "max|u|"), ("alpha", "alpha"))
 
 
-def load(files):
-    rows = []
+def lines(files):
     for f in files:
         for line in open(f):
-            line = line.strip()
-            if line:
-                r = json.loads(line)
-                if r.get("converged") and r.get("estimate_ok") and "true_rel_l2" in r:
-                    rows.append(r)
+            if line.strip():
+                yield json.loads(line)
+
+
+def case_key(r):
+    return r["case"], r["shape"], r["load"], round(r["target"], 9)
+
+
+def load(files, truths=()):
+    known = {case_key(t): t for t in lines(truths) if "true_rel_l2" in t}
+    rows = []
+    for r in lines(files):
+        if "true_rel_l2" not in r and case_key(r) in known:
+            r.update({k: v for k, v in known[case_key(r)].items() if k.startswith("true_")})
+        if r.get("converged") and r.get("estimate_ok") and "true_rel_l2" in r:
+            rows.append(r)
     return rows
 
 
@@ -59,8 +73,9 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("files", nargs="+")
     ap.add_argument("--plot", help="PNG: estimate against true error, log-log")
+    ap.add_argument("--truths", nargs="+", default=[], help="runs with references: the true errors of estimate-only runs")
     a = ap.parse_args()
-    rows = load(a.files)
+    rows = load(a.files, a.truths)
     if not rows:
         print("no complete cases", file=sys.stderr)
         return 1

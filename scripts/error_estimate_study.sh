@@ -2,7 +2,7 @@
 # The validation of the labels' error estimate in docs/ACCURACY.md ("Every label knows its own
 # error"): build/study_error_estimate on the accuracy study's scenes and on random Random2D /
 # Random3D load cases, then scripts/error_estimate_report.py (table + log-log plot).
-#   scripts/error_estimate_study.sh [PART...]    parts: random2d scenes2d p2 random2d_p2 easy_random2d_p2 graded random2d_rim easy_random2d_rim random3d random3d_h03 scenes3d report
+#   scripts/error_estimate_study.sh [PART...]    parts: random2d scenes2d p2 random2d_p2 easy_random2d_p2 graded random2d_rim easy_random2d_rim relaxation random3d random3d_h03 scenes3d report
 #                                                (default: all; each appends to docs/error_estimate/PART.jsonl)
 # One rank, OPENBLAS_NUM_THREADS=1; references with MUMPS (-ref_ prefix). Runtime on the shared
 # 2-core VM: random2d ~10 min, scenes2d ~5, p2 ~10, random3d/scenes3d ~10 each.
@@ -57,6 +57,31 @@ for part in "${parts[@]}"; do
       "$BIN" --preset random3d --shapes $(seq 0 9) --loads 1 --levels 1 --out "$OUT/random3d_h03.jsonl" -- "${ref[@]}" ;;
     scenes3d)
       "$BIN" --scene ball --h 0.5 --levels 2 --out "$OUT/scenes3d.jsonl" -- "${ref[@]}" ;;
+    relaxation)  # the estimate alone (--estimate-only) on the cases above with a truth, with and without
+                 # local relaxation of the fine state (since 2026-11-29), joined with those truths
+      R="$OUT/relaxation"
+      mkdir -p "$R"
+      for t in relax off; do
+        o=()
+        [ $t = off ] && o=(-error_estimate_no_relaxation)
+        rm -f "$R"/*_$t.jsonl
+        E=(--estimate-only -- "${o[@]}")
+        "$BIN" --preset random2d_p1 --shapes $(seq 0 16) --loads 3 --out "$R/random2d_$t.jsonl" "${E[@]}"
+        for s in disk r2d-0 r2d-1 ood-0 easy-0; do "$BIN" --scene $s --out "$R/scenes2d_$t.jsonl" "${E[@]}"; done
+        for s in disk r2d-0 r2d-1 ood-0; do "$BIN" --scene $s --degree 2 --h 0.08 --out "$R/p2_$t.jsonl" "${E[@]}"; done
+        "$BIN" --preset random2d_p1 --degree 2 --h 0.08 --shapes $(seq 20 27) --loads 2 --out "$R/random2d_p2_$t.jsonl" "${E[@]}"
+        for g in 0 0.0625; do
+          "$BIN" --preset random2d --graded $g --shapes $(seq 20 27) --loads 2 --out "$R/rim_random2d_graded${g}_$t.jsonl" "${E[@]}"
+        done
+        "$BIN" --preset random2d --shapes $(seq 20 27) --loads 2 --out "$R/rim_random2d_$t.jsonl" "${E[@]}"
+        for g in 0 0.0625 0.03125; do
+          "$BIN" --preset easy_random2d --graded $g --shapes $(seq 20 27) --loads 2 --out "$R/rim_easy_random2d_graded${g}_$t.jsonl" "${E[@]}"
+        done
+        "$BIN" --preset random3d --shapes $(seq 0 9) --loads 1 --out "$R/random3d_$t.jsonl" "${E[@]}"
+        echo "== local relaxation: $t"
+        /usr/bin/python3 scripts/error_estimate_report.py "$R"/*_$t.jsonl --truths "$OUT"/rim/*.jsonl \
+          $(ls "$OUT"/*.jsonl | grep -v 'random3d_h03\|s022_one_step')
+      done ;;
     report)
       /usr/bin/python3 scripts/error_estimate_report.py "$OUT"/*.jsonl --plot docs/figures/error_estimate.png ;;
     *) echo "unknown part $part" >&2; exit 2 ;;

@@ -40,8 +40,8 @@ std::vector<PetscInt> global_of_local_dofs(const physics::Problem& problem) {
   return out;
 }
 
-LocalRelaxation::LocalRelaxation(const physics::Problem& problem)
-    : problem_(problem), dim_(problem.space().dim()), gol_(global_of_local_dofs(problem)) {
+LocalRelaxation::LocalRelaxation(const physics::Problem& problem, int max_seeds)
+    : problem_(problem), dim_(problem.space().dim()), max_seeds_(max_seeds), gol_(global_of_local_dofs(problem)) {
   const physics::Space& sp = problem.space();
   const PetscInt n_nodes = PetscInt(gol_.size()) / dim_;
   const int nb = sp.n_nodes();
@@ -143,7 +143,7 @@ LocalRelaxation::Result LocalRelaxation::relax(Vec u, double s, Vec r, Vec fixed
         seeds.push_back(n);
         seeded += node2[std::size_t(n)];
       }
-    if (!(largest > 0) || seeds.size() > std::size_t(kMaxSeeds) || seeded < 0.5 * total) return out;
+    if (!(largest > 0) || seeds.size() > std::size_t(max_seeds_) || seeded < 0.5 * total) return out;
   }
   {
     core::VecArray<const PetscScalar> fx(fixed);

@@ -167,6 +167,7 @@ void run_shape(const config::DatasetConfig& cfg, const factory::ShapeSample& sha
       j["estimate_krylov_budget_spent"] = e.krylov_budget_spent;
       j["estimate_tangent_assemblies"] = e.tangent_assemblies;
       j["estimate_residual_assemblies"] = e.residual_assemblies;
+      j["estimate_relaxations"] = e.relaxations;
       std::vector<std::vector<double>> u;
       std::vector<double> alphas;
       std::string why;

@@ -11,6 +11,8 @@
 #include <functional>
 #include <random>
 #include <stdexcept>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "hypershape/core/error.hpp"
@@ -28,6 +30,17 @@ using Field = std::function<void(const double* x, double* u)>;
 /// A local vector of the problem's DM holding the global vector `u`, with the homogeneous
 /// essential values (zero) in the constrained slots. Collective.
 /// Entries of this rank's part of a global vector.
+/// A PETSc option set for a scope (cleared at its end, also when a REQUIRE leaves it).
+struct ScopedOption {
+  std::string name;
+  ScopedOption(std::string n, const char* value = nullptr) : name(std::move(n)) {
+    HS_PETSC(PetscOptionsSetValue(nullptr, name.c_str(), value));
+  }
+  ~ScopedOption() { PetscOptionsClearValue(nullptr, name.c_str()); }
+  ScopedOption(const ScopedOption&) = delete;
+  ScopedOption& operator=(const ScopedOption&) = delete;
+};
+
 inline std::vector<double> values(Vec v) {
   PetscInt n;
   HS_PETSC(VecGetLocalSize(v, &n));

@@ -28,6 +28,7 @@
 #include "hypershape/core/petsc_handle.hpp"
 #include "hypershape/mesh/refine.hpp"
 #include "hypershape/physics/problem.hpp"
+#include "hypershape/solver/local_relaxation.hpp"
 
 namespace hypershape::solver {
 
@@ -44,6 +45,7 @@ struct ErrorEstimate {
   double raw_max_u = 0;      ///< max_u with theta = 1
   double slope = 0;          ///< dmax|u| / dalpha used for the alpha estimate
   int krylov_iterations = 0;
+  int relaxations = 0;       ///< fine states relaxed locally before a Newton step (LocalRelaxation)
   bool krylov_budget_spent = false;  ///< a fine step stopped at the Krylov budget (its iterate kept)
   bool newton_steps_converged = false;  ///< one full Newton step, or steps to 1% of the first residual
   int residual_assemblies = 0, tangent_assemblies = 0, factorizations = 0;
@@ -107,6 +109,9 @@ class TwoLevelEstimator {
   /// The largest step lambda in {1, 1/2, ..., > 0.03} with E(x + lambda dx) <= E(x) = ex (w: that
   /// state, ew: its energy), or 0. Energy evaluations counted in out.seconds_assembly.
   double energy_search(Vec x, double ex, Vec dx, double alpha, Vec w, double& ew, ErrorEstimate& out) const;
+  /// Relaxes x on the patch where the fine residual r sits (LocalRelaxation; one rank,
+  /// conservative problems), then its energy ex, r and |r| = rn anew; false where nothing moved.
+  bool relax(Vec x, double alpha, Vec r, double& ex, PetscReal& rn, ErrorEstimate& out) const;
   /// The coarse level: y = K_c^-1 x by `coarse_` (the caller's factor) or by `direct_`.
   void coarse_apply(Vec x, Vec y, bool refined) const;
   static PetscErrorCode apply_coarse(PC pc, Vec x, Vec y);
@@ -131,6 +136,8 @@ class TwoLevelEstimator {
   /// Work vectors (fine: x, r, dx, w, g, P u_h, e; coarse: du/dalpha), made at the first estimate.
   mutable std::vector<core::VecH> fv_;
   mutable core::VecH du_dalpha_;
+  mutable std::unique_ptr<LocalRelaxation> relaxation_;  ///< relax()'s, made at its first use
+  mutable core::VecH no_fixed_;                           ///< zero: no dof held in the relaxation
 };
 
 }  // namespace hypershape::solver

@@ -24,8 +24,10 @@ std::vector<PetscInt> global_of_local_dofs(const physics::Problem& problem);
 
 class LocalRelaxation {
  public:
-  /// Collective (the dof maps); relax() then works on rank-local data only.
-  explicit LocalRelaxation(const physics::Problem& problem);
+  /// Collective (the dof maps); relax() then works on rank-local data only. `max_seeds`: the
+  /// most nodes a trouble spot may have (kMaxSeeds; more on a uniformly refined mesh, whose
+  /// spots span 2^dim times the nodes).
+  explicit LocalRelaxation(const physics::Problem& problem, int max_seeds = kMaxSeeds);
 
   struct Result {
     bool relaxed = false;  ///< u was changed
@@ -34,7 +36,7 @@ class LocalRelaxation {
     double before = 0;     ///< |R| on the patch's dofs before
     double after = 0;      ///< and after
   };
-  /// `r` = R(u, s) (global). Where more than half of |R|^2 sits on at most kMaxSeeds nodes (those
+  /// `r` = R(u, s) (global). Where more than half of |R|^2 sits on at most max_seeds nodes (those
   /// with |R_node| >= a tenth of the largest), relaxes u on the patch of cells within three rings
   /// of them in 2D, two in 3D (the dofs whose cells all lie in the patch; not those where `fixed`, a global vector, is
   /// non-zero: the control node), until the patch's residual is a tenth of the rest's or a
@@ -53,6 +55,7 @@ class LocalRelaxation {
 
   const physics::Problem& problem_;
   int dim_;
+  int max_seeds_;
   std::vector<PetscInt> gol_;                     ///< global_of_local_dofs
   std::vector<PetscInt> node_cells_ptr_, node_cells_;  ///< cells of each node (CSR by node)
   std::vector<PetscInt> cells_;                   ///< the patch's cells, sorted
