@@ -2,7 +2,7 @@
 # The validation of the labels' error estimate in docs/ACCURACY.md ("Every label knows its own
 # error"): build/study_error_estimate on the accuracy study's scenes and on random Random2D /
 # Random3D load cases, then scripts/error_estimate_report.py (table + log-log plot).
-#   scripts/error_estimate_study.sh [PART...]    parts: random2d scenes2d p2 random2d_p2 easy_random2d_p2 graded random2d_rim easy_random2d_rim relaxation random3d random3d_h03 scenes3d report
+#   scripts/error_estimate_study.sh [PART...]    parts: random2d scenes2d p2 random2d_p2 easy_random2d_p2 graded random2d_rim easy_random2d_rim one_random2d_rim relaxation random3d random3d_h03 scenes3d report
 #                                                (default: all; each appends to docs/error_estimate/PART.jsonl)
 # One rank, OPENBLAS_NUM_THREADS=1; references with MUMPS (-ref_ prefix). Runtime on the shared
 # 2-core VM: random2d ~10 min, scenes2d ~5, p2 ~10, random3d/scenes3d ~10 each.
@@ -57,6 +57,12 @@ for part in "${parts[@]}"; do
       "$BIN" --preset random3d --shapes $(seq 0 9) --loads 1 --levels 1 --out "$OUT/random3d_h03.jsonl" -- "${ref[@]}" ;;
     scenes3d)
       "$BIN" --scene ball --h 0.5 --levels 2 --out "$OUT/scenes3d.jsonl" -- "${ref[@]}" ;;
+    one_random2d_rim)  # one_random2d's family (P2 h 0.08) as drawn and graded to 0.00375 (the preset since
+                       # 2026-11-29), shapes 20-25 of its seed
+      mkdir -p "$OUT/rim"
+      for g in 0 0.046875; do
+        "$BIN" --preset one_random2d --graded $g --shapes $(seq 20 25) --loads 2 --out "$OUT/rim/one_random2d_graded$g.jsonl" -- "${ref[@]}"
+      done ;;
     relaxation)  # the estimate alone (--estimate-only) on the cases above with a truth, with and without
                  # local relaxation of the fine state (since 2026-11-29), joined with those truths
       R="$OUT/relaxation"
