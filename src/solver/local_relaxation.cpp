@@ -10,6 +10,7 @@
 
 #include "hypershape/core/error.hpp"
 #include "hypershape/core/vec_array.hpp"
+#include "log_events.hpp"
 
 namespace hypershape::solver {
 
@@ -123,6 +124,7 @@ bool LocalRelaxation::patch_energy(Vec u, double s, double& e) {
 }
 
 LocalRelaxation::Result LocalRelaxation::relax(Vec u, double s, Vec r, Vec fixed) {
+  LogEvent logged(events().relaxation);
   Result out;
   std::vector<PetscInt> seeds;
   double total = 0;

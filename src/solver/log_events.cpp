@@ -21,6 +21,7 @@ const Events& events() {
     HS_PETSC(PetscLogEventRegister("HSStability", cls, &r.stability));
     HS_PETSC(PetscLogEventRegister("HSFactorSingle", cls, &r.single_factor));
     HS_PETSC(PetscLogEventRegister("HSFactorBlocked", cls, &r.blocked_factor));
+    HS_PETSC(PetscLogEventRegister("HSRelax", cls, &r.relaxation));
     HS_PETSC(PetscLogEventRegister("HSEstimate", cls, &r.estimate));
     HS_PETSC(PetscLogEventRegister("HSEstFineAsm", cls, &r.estimate_fine_assembly));
     HS_PETSC(PetscLogEventRegister("HSEstFineSolve", cls, &r.estimate_fine_solve));

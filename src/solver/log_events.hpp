@@ -15,7 +15,7 @@ namespace hypershape::solver {
 
 struct Events {
   PetscLogEvent tangent_assembly, factorisation, factor_solve, krylov, predictor, corrector,
-      branch_switch, load_control, multigrid_setup, stability, single_factor, blocked_factor;
+      branch_switch, load_control, multigrid_setup, stability, single_factor, blocked_factor, relaxation;
   PetscLogEvent estimate, estimate_fine_assembly, estimate_fine_solve, estimate_values;
 };
 
