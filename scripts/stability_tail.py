@@ -50,8 +50,9 @@ def main(dirs):
           f"{tail.sum()} ({100 * tail.mean():.1f}%) above 3x the median")
     for k in KEYS:
         v = np.array([r[k] for r in data], float)
-        print(f"  {k:>10}: tail median {np.median(v[tail]):.3g} (p10-p90 {np.percentile(v[tail], 10):.3g}-"
-              f"{np.percentile(v[tail], 90):.3g}), the rest {np.median(v[~tail]):.3g}")
+        t = (f"tail median {np.median(v[tail]):.3g} (p10-p90 {np.percentile(v[tail], 10):.3g}-"
+             f"{np.percentile(v[tail], 90):.3g})" if tail.any() else "no tail")
+        print(f"  {k:>10}: {t}, the rest {np.median(v[~tail]):.3g}")
     share("target", np.array([r["target"] for r in data]), tail, [0, 0.2, 0.3, 0.4, 0.5, 2])
     share("p_N to the patch", np.array([r["to_clamp"] for r in data]), tail, [-9, 0.1, 0.3, 0.6, 9])
     return 0

@@ -111,6 +111,27 @@ def check_png(d, tmp, name):
                                                f"({os.path.getsize(out) if ok else 0} bytes) {r.stderr[-300:]}")
 
 
+def check_tail(d):
+    """scripts/stability_tail.py on the mini: its tail (above 3x the median Newton iterations) and
+    its bins by the distance of p_N to the patch, against the same counted from the arrays here."""
+    r = run("/usr/bin/python3", os.path.join(src, "scripts", "stability_tail.py"), d)
+    its, dist = [], []
+    for shard in sorted(os.listdir(os.path.join(d, "shards"))):
+        with h5py.File(os.path.join(d, "shards", shard)) as h:
+            for g in h["shapes"].values():
+                p_d, rad = np.asarray(g.attrs["dirichlet_center"])[:2], g.attrs["dirichlet_radius"]
+                its += list(g["loads"]["newton_iterations"][()])
+                dist += [np.linalg.norm(p[:2] - p_d) - rad for p in g["loads"]["p_n"][()]]
+    its, dist = np.array(its, float), np.array(dist)
+    tail = int((its > 3 * np.median(its)).sum())
+    near = int((dist < 0.1).sum())
+    head = f"{len(its)} load cases: Newton its median {np.median(its):g}"
+    ok = r.returncode == 0 and r.stdout.startswith(head) and f"{tail} (" in r.stdout.splitlines()[0] and \
+        f"p_N to the patch [-9, 0.1): {near} load cases" in r.stdout
+    check(ok, f"stability_tail.py: {len(its)} load cases, {tail} in the tail, {near} with p_N within 0.1 of the patch "
+              f"{r.stdout.splitlines()[:1]} {r.stderr[-200:]}")
+
+
 def main():
     tmp = tempfile.mkdtemp()
     try:
@@ -120,6 +141,7 @@ def main():
             check_pieces(d2, 2)
             check_colours(d2)
             check_png(d2, tmp, "mini2d")
+            check_tail(d2)
         cfg = f"{tmp}/p3.yaml"
         open(cfg, "w").write("preset: random3d\nname: p3\nseed: 7\nshapes: {count: 1}\nloads: {count: 2}\n"
                              "representations: {grid_size: 8}\n")
