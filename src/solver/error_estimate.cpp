@@ -13,6 +13,7 @@
 #include "hypershape/core/vec_array.hpp"
 #include "hypershape/mesh/reference_cell.hpp"
 #include "hypershape/solver/ldlt.hpp"
+#include "hypershape/solver/local_relaxation.hpp"
 #include "log_events.hpp"
 
 namespace hypershape::solver {

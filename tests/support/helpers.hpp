@@ -27,9 +27,6 @@ namespace hstest {
 namespace hs = hypershape;
 using Field = std::function<void(const double* x, double* u)>;
 
-/// A local vector of the problem's DM holding the global vector `u`, with the homogeneous
-/// essential values (zero) in the constrained slots. Collective.
-/// Entries of this rank's part of a global vector.
 /// A PETSc option set for a scope (cleared at its end, also when a REQUIRE leaves it).
 struct ScopedOption {
   std::string name;
@@ -41,6 +38,9 @@ struct ScopedOption {
   ScopedOption& operator=(const ScopedOption&) = delete;
 };
 
+/// A local vector of the problem's DM holding the global vector `u`, with the homogeneous
+/// essential values (zero) in the constrained slots. Collective.
+/// Entries of this rank's part of a global vector.
 inline std::vector<double> values(Vec v) {
   PetscInt n;
   HS_PETSC(VecGetLocalSize(v, &n));

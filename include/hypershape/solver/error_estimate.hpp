@@ -28,9 +28,10 @@
 #include "hypershape/core/petsc_handle.hpp"
 #include "hypershape/mesh/refine.hpp"
 #include "hypershape/physics/problem.hpp"
-#include "hypershape/solver/local_relaxation.hpp"
 
 namespace hypershape::solver {
+
+class LocalRelaxation;  // solver/local_relaxation.hpp (Eigen): kept out of this header
 
 struct ErrorEstimate {
   bool ok = false;           ///< false: the estimate could not be formed (values 0)
@@ -72,7 +73,9 @@ class TwoLevelEstimator {
   /// `coarse`: the solved problem; `fine`: the same scene on `refined.mesh` (same degree), whose
   /// coarse mesh is the one `coarse` was built from. Builds P. Collective over the problems'
   /// communicator (the same for both). The linear solve reads PETSc options with prefix
-  /// "error_estimate_" (-error_estimate_ksp_rtol, -error_estimate_mg_levels_ksp_max_it, ...).
+  /// "error_estimate_" (-error_estimate_ksp_rtol, -error_estimate_mg_levels_ksp_max_it, ...);
+  /// -error_estimate_no_relaxation and -error_estimate_relaxation_seeds N (default 2^dim x
+  /// LocalRelaxation::kMaxSeeds) set the local relaxation of the fine states (relax()).
   /// `newton_to_tolerance`: Newton on the fine problem to 1% of its first residual (at most 4
   /// steps) even when the first step is a full one (the mean-dilatation element's estimates
   /// need it); otherwise one full step is the estimate.
