@@ -368,7 +368,7 @@ double Problem::min_det_f(Vec u) const {
       detail::gather<D, NB>(s, c, a, ue);
       for (int q = 0; q < s.n_qp(); ++q) {
         detail::physical_gradients<D, NB>(s, c, q, G);
-        m = std::min(m, (Tensor<D>::Identity() + ue.transpose() * G).determinant());
+        m = std::min(m, detail::deformation_gradient<D, NB>(ue, G).determinant());
       }
     }
     return true;

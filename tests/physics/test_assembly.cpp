@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <random>
 #include <string>
 #include <utility>
 
@@ -345,4 +346,51 @@ TEST_CASE("The 2D tangent's point contribution is Eigen's product, bit for bit",
       for (int i = 0; i < D; ++i) eigen.row(a * D + i).noalias() += w * (G.row(a) * AGc.middleRows<D>(i * D));
   }
   CHECK(std::memcmp(mine.data(), eigen.data(), sizeof(double) * ND * ND) == 0);
+}
+
+namespace {
+
+/// The 2D element loops' hand-written sums against the Eigen products they replaced (hyperelastic.hpp):
+/// every bit the same on random arguments, so the datasets keep theirs.
+template <int NB>
+void check_kernel_sums() {
+  std::mt19937_64 gen(20261129 + NB);
+  std::normal_distribution<double> normal;
+  auto fill = [&](auto& m, double scale) {
+    for (Eigen::Index k = 0; k < m.size(); ++k) m.data()[k] = scale * normal(gen);
+  };
+  auto same = [](const auto& a, const auto& b) { return std::memcmp(a.data(), b.data(), sizeof(double) * std::size_t(a.size())) == 0; };
+  int differ_f = 0, differ_r = 0, differ_ag = 0;
+  for (int t = 0; t < 20000; ++t) {
+    Eigen::Matrix<double, NB, 2> ue, G, re;
+    physics::Tensor<2> P;
+    physics::Tangent<2> A;
+    fill(ue, 0.1);
+    fill(G, 10.0);
+    fill(re, 1.0);
+    fill(P, 1.0);
+    fill(A, 1.0);
+    const double w = std::abs(normal(gen)) * 1e-3;
+    const physics::Tensor<2> F = physics::Tensor<2>::Identity() + ue.transpose() * G;
+    differ_f += !same(F, physics::detail::deformation_gradient<2, NB>(ue, G));
+    Eigen::Matrix<double, NB, 2> re_eigen = re;
+    re_eigen.noalias() += w * (G * P.transpose());
+    physics::detail::add_point_residual<2, NB>(G, P, w, re);
+    differ_r += !same(re, re_eigen);
+    Eigen::Matrix<double, 4, 2 * NB, Eigen::RowMajor> AG, AG_eigen;
+    for (int b = 0; b < NB; ++b)
+      for (int k = 0; k < 2; ++k) AG_eigen.col(b * 2 + k).noalias() = A.template middleCols<2>(k * 2) * G.row(b).transpose();
+    physics::detail::tangent_gradients<2, NB>(A, G, AG);
+    differ_ag += !same(AG, AG_eigen);
+  }
+  CHECK(differ_f == 0);
+  CHECK(differ_r == 0);
+  CHECK(differ_ag == 0);
+}
+
+}  // namespace
+
+TEST_CASE("2D element loops sum as Eigen's products did, bit for bit", "[physics][assembly]") {
+  SECTION("P1") { check_kernel_sums<3>(); }
+  SECTION("P2") { check_kernel_sums<6>(); }
 }

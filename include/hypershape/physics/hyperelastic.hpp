@@ -25,12 +25,61 @@ namespace hypershape::physics {
 
 namespace detail {
 
+// The 2D loops below are written out by hand where Eigen's fixed-size products were out-of-line
+// calls (F = I + ue^T G alone took 9% of a Random2D P2 run's CPU, `perf`), each summing in the
+// order Eigen's vectorised product sums (tested bit for bit in unit.physics.assembly), so the
+// data keep every bit. 3D keeps Eigen's products: there the factorisations are the cost.
+
 /// Physical basis gradients G (NB x D) of cell c at quadrature point q.
 template <int D, int NB>
 [[gnu::always_inline]] inline void physical_gradients(const Space& s, PetscInt c, int q, Eigen::Matrix<double, NB, D>& G) {
   Eigen::Map<const Eigen::Matrix<double, NB, D, Eigen::RowMajor>> dref(s.ref_grad(q));
   Eigen::Map<const Eigen::Matrix<double, D, D, Eigen::RowMajor>> iJ(s.inv_jacobian(c));
-  G.noalias() = dref * iJ;  // dN/dx_j = sum_k dN/dxi_k dxi_k/dx_j
+  if constexpr (D == 2) {
+    for (int j = 0; j < 2; ++j)
+      for (int a = 0; a < NB; ++a) G(a, j) = dref(a, 0) * iJ(0, j) + dref(a, 1) * iJ(1, j);
+  } else {
+    G.noalias() = dref * iJ;  // dN/dx_j = sum_k dN/dxi_k dxi_k/dx_j
+  }
+}
+
+/// F = I + ue^T G: F_ij = delta_ij + sum_a ue(a, i) G(a, j). In 2D P2 as Eigen sums six terms in
+/// lanes of two (the even and the odd a, each lane's last two first, then the lanes' sum); P1's
+/// three in turn.
+template <int D, int NB>
+[[gnu::always_inline]] inline Tensor<D> deformation_gradient(const Eigen::Matrix<double, NB, D>& ue,
+                                                             const Eigen::Matrix<double, NB, D>& G) {
+  if constexpr (D == 2 && (NB == 3 || NB == 6)) {
+    Tensor<2> F;
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 2; ++i) {
+        double sum;
+        if constexpr (NB == 6) {
+          const double even = ue(0, i) * G(0, j) + (ue(2, i) * G(2, j) + ue(4, i) * G(4, j));
+          const double odd = ue(1, i) * G(1, j) + (ue(3, i) * G(3, j) + ue(5, i) * G(5, j));
+          sum = even + odd;
+        } else {
+          sum = ue(0, i) * G(0, j) + ue(1, i) * G(1, j) + ue(2, i) * G(2, j);
+        }
+        F(i, j) = (i == j ? 1.0 : 0.0) + sum;
+      }
+    return F;
+  } else {
+    return Tensor<D>::Identity() + ue.transpose() * G;
+  }
+}
+
+/// re += w G P^T: re_ai += sum_J w G_aJ P_iJ (a quadrature point's part of the cell residual), with
+/// w G_aJ formed first as Eigen forms it.
+template <int D, int NB>
+[[gnu::always_inline]] inline void add_point_residual(const Eigen::Matrix<double, NB, D>& G, const Tensor<D>& P, double w,
+                                                      Eigen::Matrix<double, NB, D>& re) {
+  if constexpr (D == 2) {
+    for (int i = 0; i < 2; ++i)
+      for (int a = 0; a < NB; ++a) re(a, i) += (w * G(a, 0)) * P(i, 0) + (w * G(a, 1)) * P(i, 1);
+  } else {
+    re.noalias() += w * (G * P.transpose());
+  }
 }
 
 template <int D, int NB>
@@ -90,6 +139,19 @@ template <class K, class T>
 bool energy_stress(const K& k, const T& F, double& W, T& P) {
   if constexpr (requires { k.energy_stress(F, W, P); }) return k.energy_stress(F, W, P);
   else return k.energy(F, W) && k.stress(F, P);
+}
+
+/// AG(iJ, b k) = sum_L A(iJ, kL) G(b, L): the point's tangent applied to each basis gradient.
+template <int D, int NB, class AGMatrix>
+[[gnu::always_inline]] inline void tangent_gradients(const Tangent<D>& A, const Eigen::Matrix<double, NB, D>& G, AGMatrix& AG) {
+  if constexpr (D == 2) {
+    for (int r = 0; r < D * D; ++r)
+      for (int b = 0; b < NB; ++b)
+        for (int k = 0; k < D; ++k) AG(r, b * D + k) = A(r, k * D) * G(b, 0) + A(r, k * D + 1) * G(b, 1);
+  } else {
+    for (int b = 0; b < NB; ++b)
+      for (int k = 0; k < D; ++k) AG.col(b * D + k).noalias() = A.template middleCols<D>(k * D) * G.row(b).transpose();
+  }
 }
 
 /// One quadrature point's part of a cell tangent: Ke(a i, :) += sum_J (w G(a, J)) AG(i J, :)
@@ -179,7 +241,7 @@ class HyperelasticEffect : public Effect {
         const double dj = s.det_jacobian(c);
         for (int q = 0; q < s.n_qp(); ++q) {
           detail::physical_gradients<D, NB>(s, c, q, G);
-          const Tensor<D> F = Tensor<D>::Identity() + ue.transpose() * G;
+          const Tensor<D> F = detail::deformation_gradient<D, NB>(ue, G);
           double W;
           if (!k.energy(F, W)) return false;
           energy += weight(s, c, q, dj) * W;
@@ -200,9 +262,9 @@ class HyperelasticEffect : public Effect {
         re.setZero();
         for (int q = 0; q < s.n_qp(); ++q) {
           detail::physical_gradients<D, NB>(s, c, q, G);
-          const Tensor<D> F = Tensor<D>::Identity() + ue.transpose() * G;
+          const Tensor<D> F = detail::deformation_gradient<D, NB>(ue, G);
           if (!k.stress(F, P)) return false;
-          re.noalias() += weight(s, c, q, dj) * (G * P.transpose());  // r_ai = sum_J P_iJ G_aJ
+          detail::add_point_residual<D, NB>(G, P, weight(s, c, q, dj), re);  // r_ai = sum_J P_iJ G_aJ
         }
         const PetscInt* idx = s.local_dofs(c);
         for (int a = 0; a < NB; ++a)
@@ -226,12 +288,12 @@ class HyperelasticEffect : public Effect {
         re.setZero();
         for (int q = 0; q < s.n_qp(); ++q) {
           detail::physical_gradients<D, NB>(s, c, q, G);
-          const Tensor<D> F = Tensor<D>::Identity() + ue.transpose() * G;
+          const Tensor<D> F = detail::deformation_gradient<D, NB>(ue, G);
           double W;
           if (!detail::energy_stress(k, F, W, P)) return false;
           const double w = weight(s, c, q, dj);
           energy += w * W;
-          re.noalias() += w * (G * P.transpose());
+          detail::add_point_residual<D, NB>(G, P, w, re);
         }
         const PetscInt* idx = s.local_dofs(c);
         for (int a = 0; a < NB; ++a)
@@ -259,12 +321,10 @@ class HyperelasticEffect : public Effect {
         Ke.setZero();
         for (int q = 0; q < s.n_qp(); ++q) {
           detail::physical_gradients<D, NB>(s, c, q, G);
-          const Tensor<D> F = Tensor<D>::Identity() + ue.transpose() * G;
+          const Tensor<D> F = detail::deformation_gradient<D, NB>(ue, G);
           if (!k.stress_tangent(F, P, A)) return false;
           const double w = weight(s, c, q, dj);
-          for (int b = 0; b < NB; ++b)
-            for (int kk = 0; kk < D; ++kk)
-              AG.col(b * D + kk).noalias() = A.template middleCols<D>(kk * D) * G.row(b).transpose();
+          detail::tangent_gradients<D, NB>(A, G, AG);
           detail::add_point_tangent<D, NB>(G, AG, w, Ke);
         }
         adder.add(c, Ke.data());

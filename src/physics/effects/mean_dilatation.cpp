@@ -135,7 +135,7 @@ class MeanDilatationNeoHookean : public Effect {
         if constexpr (hessian) cell.H.setZero();
         for (int q = 0; q < s.n_qp(); ++q) {
           detail::physical_gradients<D, NB>(s, c, q, G);
-          const Tensor<D> F = Tensor<D>::Identity() + ue.transpose() * G;
+          const Tensor<D> F = detail::deformation_gradient<D, NB>(ue, G);
           const double Jq = F.determinant();
           if (!(Jq > 0)) return false;
           const double w = s.qweight(q) * dj;
