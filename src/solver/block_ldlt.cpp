@@ -5,6 +5,7 @@
 #include <petsc/private/kernels/blockinvert.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -196,6 +197,7 @@ void BlockLdlt2::analyse(PetscInt nb, const PetscInt* rows, const PetscInt* cols
 }
 
 bool BlockLdlt2::factorise(const PetscScalar* a) {
+  dabs_current_ = false;
   const Arrays f{nb_, ai_.data(), aj_.data(), ui_.data(), uj_.data(), d_.data(), u_.data(), row_.data(), next_.data(),
                  first_.data()};
   return eliminate(f, a);
@@ -229,6 +231,26 @@ void BlockLdlt2::solve(PetscScalar* x) const {
 
 void BlockLdlt2::solve2(PetscScalar* x) const {
   substitute2(Factor{nb_, ui_.data(), uj_.data(), d_.data(), u_.data()}, x);
+}
+
+void BlockLdlt2::solve2_absolute(PetscScalar* x) const {
+  if (!dabs_current_) {
+    dabs_.assign(d_.begin(), d_.end());
+    for (PetscInt k = 0; k < nb_; ++k) {
+      double* v = &dabs_[4 * std::size_t(k)];
+      const double a = v[0], b = 0.5 * (v[1] + v[2]), d = v[3];
+      if (a * d - b * b > 0 && a > 0) continue;
+      const double mean = 0.5 * (a + d), radius = std::hypot(0.5 * (a - d), b);
+      const double l1 = mean + radius, l2 = mean - radius;
+      const double t = std::atan2(2 * b, a - d) / 2;
+      const double c = std::cos(t), s = std::sin(t), m1 = std::abs(l1), m2 = std::abs(l2);
+      v[0] = m1 * c * c + m2 * s * s;
+      v[1] = v[2] = (m1 - m2) * c * s;
+      v[3] = m1 * s * s + m2 * c * c;
+    }
+    dabs_current_ = true;
+  }
+  substitute2(Factor{nb_, ui_.data(), uj_.data(), dabs_.data(), u_.data()}, x);
 }
 
 int negative_eigenvalues_2x2(const PetscScalar* dinv, PetscInt nb) {

@@ -302,7 +302,7 @@ bool LdltFactor::solve(Vec b, Vec x) {
   return true;
 }
 
-bool LdltFactor::solve_pair(Vec b1, Vec x1, Vec b2, Vec x2) {
+bool LdltFactor::solve_pair(Vec b1, Vec x1, Vec b2, Vec x2, bool absolute) {
   if (!blocked_) return solve(b1, x1) && solve(b2, x2);
   to_new(b1, xp_);
   to_new(b2, xp2_);
@@ -313,7 +313,8 @@ bool LdltFactor::solve_pair(Vec b1, Vec x1, Vec b2, Vec x2) {
       pair_[4 * k] = p1[i], pair_[4 * k + 1] = p1[i + 1], pair_[4 * k + 2] = p2[i], pair_[4 * k + 3] = p2[i + 1];
     }
   }
-  block_.solve2(pair_.data());
+  if (absolute) block_.solve2_absolute(pair_.data());
+  else block_.solve2(pair_.data());
   {
     core::VecArray<PetscScalar> y1(yp_), y2(yp2_);
     for (std::size_t k = 0; 2 * k < old_of_new_.size(); ++k) {
@@ -321,9 +322,9 @@ bool LdltFactor::solve_pair(Vec b1, Vec x1, Vec b2, Vec x2) {
       y1[i] = pair_[4 * k], y1[i + 1] = pair_[4 * k + 1], y2[i] = pair_[4 * k + 2], y2[i + 1] = pair_[4 * k + 3];
     }
   }
-  refine(xp_, yp_);
+  if (!absolute) refine(xp_, yp_);  // (refinement would take U^T |D| U's solutions back to A's)
   to_old(yp_, x1);
-  refine(xp2_, yp2_);
+  if (!absolute) refine(xp2_, yp2_);
   to_old(yp2_, x2);
   return true;
 }

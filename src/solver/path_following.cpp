@@ -184,20 +184,30 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
       return false;
     }
     PetscReal ca, cb;
-    HS_PETSC(VecDot(c_, a_, &ca));
-    HS_PETSC(VecDot(c_, b_, &cb));
-    if (!(std::abs(ca) > 0) || !std::isfinite(ca)) {
-      why = "singular bordered system";
-      return false;
+    double dalpha = 0, dalpha2 = 0, lambda = 0;
+    for (int attempt = 0;; ++attempt) {
+      HS_PETSC(VecDot(c_, a_, &ca));
+      HS_PETSC(VecDot(c_, b_, &cb));
+      if (!(std::abs(ca) > 0) || !std::isfinite(ca)) {
+        why = "singular bordered system";
+        return false;
+      }
+      dalpha = (d - m + cb) / ca;
+      // du is Newton's step for equilibrium at the load s + dalpha: take it with the guarded
+      // energy line search at that load, and the same fraction of dalpha.
+      const double s_full = s_ + dalpha;
+      HS_PETSC(VecAXPBYPCZ(du_, 1.0, -dalpha, 0.0, b_, a_));  // Y = -du = b - dalpha a
+      HS_PETSC(VecAXPY(r_, -dalpha, problem_.load_at(u_)));  // R(u, s + dalpha)
+      dalpha2 = chebyshev_corrector(rtol) ? chebyshev_step(s_full, ca, r_) : 0.0;
+      lambda = backtrack(u_, du_, r_, s_full + dalpha2, w_, b_);
+      if (attempt > 0 || !(lambda < 0.3) || !absolute_pivots(rtol)) break;
+      HS_PETSC(VecAXPY(r_, dalpha + dalpha2, problem_.load_at(u_)));  // R(u, s) again
+      HS_PETSC(PetscInfo(snes_.get(), "corrector %d: step %g with %d negative pivots: again with |D|\n", k, lambda, negative_pivots_));
+      if (!tangent_->solve_pair(problem_.load_at(u_), a_, false, r_, b_, true)) {
+        why = "tangent solve failed";
+        return false;
+      }
     }
-    const double dalpha = (d - m + cb) / ca;
-    // du is Newton's step for equilibrium at the load s + dalpha: take it with the guarded
-    // energy line search at that load, and the same fraction of dalpha.
-    const double s_full = s_ + dalpha;
-    HS_PETSC(VecAXPBYPCZ(du_, 1.0, -dalpha, 0.0, b_, a_));  // Y = -du = b - dalpha a
-    HS_PETSC(VecAXPY(r_, -dalpha, problem_.load_at(u_)));  // R(u, s + dalpha)
-    const double dalpha2 = chebyshev_corrector(rtol) ? chebyshev_step(s_full, ca, r_) : 0.0;
-    const double lambda = backtrack(u_, du_, r_, s_full + dalpha2, w_, b_);
     HS_PETSC(PetscInfo(snes_.get(), "corrector %d: |R| %g (%g to go), |u_k| - d %g, dalpha %g (c.a %g, c.b %g), step %g, %d negative pivots\n",
                        k, rn, rn / (opt_.atol + rtol * std::abs(s_) * fnorm), g, dalpha, double(ca), double(cb), lambda,
                        negative_pivots_));
@@ -217,6 +227,19 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
     HS_PETSC(VecNorm(r_, NORM_2, &rn));
     creep.step(lambda, rn);
   }
+}
+
+bool NonlinearSolver::absolute_pivots(double rtol) const {
+  // Opt-in (-path_absolute_pivots; docs/STABILITY.md, "Modified Newton"): an intermediate
+  // iterate whose tangent is indefinite and whose Newton step the line search cut below 0.3
+  // (no descent direction of the energy there: the cells at a clamp's end compressed past what
+  // they allow) steps again with U^T |D| U, the same factor with its indefinite 2x2 pivots made
+  // positive (Gill, Murray & Wright, Practical Optimization, 4.4.2): a descent direction, one
+  // more pair of triangular solves. Not on the last increment: its state on target is reached
+  // and classified (stable, or a fold).
+  PetscBool on = PETSC_FALSE;
+  PetscOptionsGetBool(nullptr, nullptr, "-path_absolute_pivots", &on, nullptr);
+  return on && rtol > opt_.rtol && negative_pivots_ > 0 && tangent_->absolute_solves();
 }
 
 bool NonlinearSolver::off_the_path(double rtol, double lambda) const {

@@ -218,11 +218,11 @@ int Tangent::stability(Vec start) {
   return factor().negative_eigenvalues();
 }
 
-bool Tangent::solve_pair(Vec b1, Vec x1, bool guess1, Vec b2, Vec x2) {
+bool Tangent::solve_pair(Vec b1, Vec x1, bool guess1, Vec b2, Vec x2, bool absolute) {
   if (multigrid() || opt_.reuse) return solve(b1, x1, guess1) && solve(b2, x2, false);
   if (!current_ && !factorise()) return false;
   LogEvent e(events().factor_solve);
-  return factor().solve_pair(b1, x1, b2, x2);
+  return factor().solve_pair(b1, x1, b2, x2, absolute);
 }
 
 bool Tangent::solve(Vec b, Vec x, bool guess) {

@@ -51,6 +51,8 @@ class BlockLdlt2 {
   void solve2(PetscScalar* x) const;
   /// Negative eigenvalues of the matrix last factorised (Sylvester: those of D).
   int negative_eigenvalues() const;
+  /// solve2 with U^T |D| U (each 2x2 block of D with its eigenvalues made positive).
+  void solve2_absolute(PetscScalar* x) const;
   PetscInt blocks() const { return nb_; }
   /// Blocks of U (strictly upper), for the flop count.
   std::size_t factor_blocks() const { return uj_.size(); }
@@ -60,6 +62,8 @@ class BlockLdlt2 {
   std::vector<PetscInt> ai_, aj_;  ///< the matrix's upper block pattern
   std::vector<PetscInt> ui_, uj_;  ///< U's strictly upper block pattern (rows, columns)
   AlignedDoubles d_;               ///< D_k^-1, 4 per row, column-major
+  mutable AlignedDoubles dabs_;    ///< |D_k|^-1 (solve2_absolute), made from d_ on demand
+  mutable bool dabs_current_ = false;
   AlignedDoubles u_;               ///< U's blocks, 4 each, column-major
   // Work arrays of the factorisation: a dense block row, and the linked lists of the rows
   // that update the row being factorised (next_[i]) and where row i's next block is (first_[i]).

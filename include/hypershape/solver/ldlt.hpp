@@ -70,12 +70,16 @@ class LdltFactor {
   bool solve(Vec b, Vec x);
   /// x1 = A^-1 b1 and x2 = A^-1 b2, the same numbers as two solve() calls (the blocked kind reads
   /// its factor once for both). False if a solve failed. Collective.
-  bool solve_pair(Vec b1, Vec x1, Vec b2, Vec x2);
+  /// `absolute` (has_absolute()): with U^T |D| U instead, unrefined (refinement would take its
+  /// solutions back to the factorised matrix's).
+  bool solve_pair(Vec b1, Vec x1, Vec b2, Vec x2, bool absolute = false);
   /// x ~ A^-1 b inside a preconditioner: the single kind's unrefined solve, the others' solve.
   bool precondition(Vec b, Vec x) { return single_ ? single_->solve_unrefined(b, x) : solve(b, x); }
   /// Negative eigenvalues of the A last factorised; -1 unknown. Collective.
   int negative_eigenvalues() const;
   bool factored() const { return factored_; }
+  /// Whether solve_pair(..., absolute = true) solves with U^T |D| U (the 2D blocked factor).
+  bool has_absolute() const { return blocked_ && !single_; }
   bool blocked() const { return blocked_; }
   bool single() const { return single_ != nullptr; }
 

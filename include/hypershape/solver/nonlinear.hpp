@@ -375,6 +375,7 @@ class NonlinearSolver {
   /// the final one), on the increment's first try, has left the path: its tangent has more
   /// negative pivots than at the increment's start and the line search cut its step (`lambda`)
   /// below 0.3.
+  bool absolute_pivots(double rtol) const;
   bool off_the_path(double rtol, double lambda) const;
   /// At the path's final state (converged to rtol): its tangent's inertia where the corrector's
   /// last factor does not give it (a kept factor, multigrid, LU). False with `why` on failure.

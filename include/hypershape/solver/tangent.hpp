@@ -106,8 +106,11 @@ class Tangent {
   /// factorisation and a direct solve. False if no solve succeeded. Collective.
   bool solve(Vec b, Vec x, bool guess);
   /// solve(b1, x1, guess1) then solve(b2, x2, false), the same numbers; a direct solver's
-  /// factor is read once for both. x1, x2 must not alias b2, b1. Collective.
-  bool solve_pair(Vec b1, Vec x1, bool guess1, Vec b2, Vec x2);
+  /// factor is read once for both. x1, x2 must not alias b2, b1. `absolute`
+  /// (absolute_solves()): with the factor's D replaced by |D| (LdltFactor::solve_pair). Collective.
+  bool solve_pair(Vec b1, Vec x1, bool guess1, Vec b2, Vec x2, bool absolute = false);
+  /// Whether the factor in use can solve with |D| (a direct 2D blocked factor, no multigrid, no reuse).
+  bool absolute_solves() const { return !multigrid() && !opt_.reuse && has_factor() && factor().has_absolute(); }
   /// Applies the inverse of the factor in use: y = F^-1 x (no Krylov). Collective.
   bool apply_factor(Vec x, Vec y, bool refined = true);
   /// Inertia of the factor in use; -1 unknown. Exact for K(u) only if factor_is_current().
