@@ -183,33 +183,11 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
       why = "tangent factorisation or solve failed";
       return false;
     }
-    PetscReal ca, cb;
-    double dalpha = 0, dalpha2 = 0, lambda = 0;
-    for (int attempt = 0;; ++attempt) {
-      HS_PETSC(VecDot(c_, a_, &ca));
-      HS_PETSC(VecDot(c_, b_, &cb));
-      if (!(std::abs(ca) > 0) || !std::isfinite(ca)) {
-        why = "singular bordered system";
-        return false;
-      }
-      dalpha = (d - m + cb) / ca;
-      // du is Newton's step for equilibrium at the load s + dalpha: take it with the guarded
-      // energy line search at that load, and the same fraction of dalpha.
-      const double s_full = s_ + dalpha;
-      HS_PETSC(VecAXPBYPCZ(du_, 1.0, -dalpha, 0.0, b_, a_));  // Y = -du = b - dalpha a
-      HS_PETSC(VecAXPY(r_, -dalpha, problem_.load_at(u_)));  // R(u, s + dalpha)
-      dalpha2 = chebyshev_corrector(rtol) ? chebyshev_step(s_full, ca, r_) : 0.0;
-      lambda = backtrack(u_, du_, r_, s_full + dalpha2, w_, b_);
-      if (attempt > 0 || !(lambda < 0.3) || !absolute_pivots(rtol)) break;
-      HS_PETSC(VecAXPY(r_, dalpha + dalpha2, problem_.load_at(u_)));  // R(u, s) again
-      HS_PETSC(PetscInfo(snes_.get(), "corrector %d: step %g with %d negative pivots: again with |D|\n", k, lambda, negative_pivots_));
-      if (!tangent_->solve_pair(problem_.load_at(u_), a_, false, r_, b_, true)) {
-        why = "tangent solve failed";
-        return false;
-      }
-    }
+    BorderedStep st;
+    if (!bordered_step(d, m, rtol, k, st, why)) return false;
+    const double dalpha = st.dalpha, dalpha2 = st.dalpha2, lambda = st.lambda;
     HS_PETSC(PetscInfo(snes_.get(), "corrector %d: |R| %g (%g to go), |u_k| - d %g, dalpha %g (c.a %g, c.b %g), step %g, %d negative pivots\n",
-                       k, rn, rn / (opt_.atol + rtol * std::abs(s_) * fnorm), g, dalpha, double(ca), double(cb), lambda,
+                       k, rn, rn / (opt_.atol + rtol * std::abs(s_) * fnorm), g, dalpha, st.ca, st.cb, lambda,
                        negative_pivots_));
     if (lambda == 0.0) {
       why = "line search found no admissible decrease";
@@ -226,6 +204,38 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
     HS_PETSC(VecWAXPY(r_, (1.0 - lambda) * (dalpha + dalpha2), problem_.load_at(u_), b_));  // R(w, s_)
     HS_PETSC(VecNorm(r_, NORM_2, &rn));
     creep.step(lambda, rn);
+  }
+}
+
+bool NonlinearSolver::bordered_step(double d, double m, double rtol, int k, BorderedStep& st, std::string& why) {
+  // From u_ with r_ = R(u_, s_), a_ = K^-1 f and b_ = K^-1 R: Newton's step on the bordered
+  // system and the line search's length of it (the trial in w_, its residual in b_); again
+  // with U^T |D| U where absolute_pivots() says so.
+  for (int attempt = 0;; ++attempt) {
+    PetscReal ca, cb;
+    HS_PETSC(VecDot(c_, a_, &ca));
+    HS_PETSC(VecDot(c_, b_, &cb));
+    st.ca = ca, st.cb = cb;
+    if (!(std::abs(ca) > 0) || !std::isfinite(ca)) {
+      why = "singular bordered system";
+      return false;
+    }
+    st.dalpha = (d - m + cb) / ca;
+    // du is Newton's step for equilibrium at the load s + dalpha: take it with the guarded
+    // energy line search at that load, and the same fraction of dalpha.
+    const double s_full = s_ + st.dalpha;
+    HS_PETSC(VecAXPBYPCZ(du_, 1.0, -st.dalpha, 0.0, b_, a_));  // Y = -du = b - dalpha a
+    HS_PETSC(VecAXPY(r_, -st.dalpha, problem_.load_at(u_)));  // R(u, s + dalpha)
+    st.dalpha2 = chebyshev_corrector(rtol) ? chebyshev_step(s_full, ca, r_) : 0.0;
+    st.lambda = backtrack(u_, du_, r_, s_full + st.dalpha2, w_, b_);
+    if (attempt > 0 || !(st.lambda < 0.3) || !absolute_pivots(rtol)) return true;
+    HS_PETSC(VecAXPY(r_, st.dalpha + st.dalpha2, problem_.load_at(u_)));  // R(u, s) again
+    HS_PETSC(PetscInfo(snes_.get(), "corrector %d: step %g with %d negative pivots: again with |D|\n", k, st.lambda,
+                       negative_pivots_));
+    if (!tangent_->solve_pair(problem_.load_at(u_), a_, false, r_, b_, true)) {
+      why = "tangent solve failed";
+      return false;
+    }
   }
 }
 

@@ -375,6 +375,11 @@ class NonlinearSolver {
   /// the final one), on the increment's first try, has left the path: its tangent has more
   /// negative pivots than at the increment's start and the line search cut its step (`lambda`)
   /// below 0.3.
+  /// A corrector step: the bordered Newton step's load increments and the line search's length.
+  struct BorderedStep {
+    double ca = 0, cb = 0, dalpha = 0, dalpha2 = 0, lambda = 0;
+  };
+  bool bordered_step(double d, double m, double rtol, int k, BorderedStep& st, std::string& why);
   bool absolute_pivots(double rtol) const;
   bool off_the_path(double rtol, double lambda) const;
   /// At the path's final state (converged to rtol): its tangent's inertia where the corrector's
