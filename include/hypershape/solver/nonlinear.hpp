@@ -371,16 +371,22 @@ class NonlinearSolver {
   /// (LocalRelaxation); where it did, r_ and `rn` are the relaxed state's. One rank,
   /// conservative problems, not with multigrid.
   bool relax_patch(PetscReal& rn);
+  /// A corrector step: c . a and c . b of the bordered system, its load increments (Newton's and
+  /// Chebyshev's) and the line search's length of it.
+  struct BorderedStep {
+    double ca = 0, cb = 0, dalpha = 0, dalpha2 = 0, lambda = 0;
+  };
+  /// From u_ (r_ = R(u_, s_), a_ = K^-1 f, b_ = K^-1 R): the bordered Newton step for c . u = d
+  /// (`m` = c . u_) and its line search (the trial in w_, its residual in b_); taken again with
+  /// U^T |D| U where absolute_pivots() says so. False with `why` on a singular system or failed solve.
+  bool bordered_step(double d, double m, double rtol, int k, BorderedStep& st, std::string& why);
+  /// -path_absolute_pivots (opt-in), an intermediate increment (`rtol` above the final one), an
+  /// indefinite tangent and a factor that can solve with |D|.
+  bool absolute_pivots(double rtol) const;
   /// With abandon_off_path: whether a corrector iterate of an intermediate increment (`rtol` above
   /// the final one), on the increment's first try, has left the path: its tangent has more
   /// negative pivots than at the increment's start and the line search cut its step (`lambda`)
   /// below 0.3.
-  /// A corrector step: the bordered Newton step's load increments and the line search's length.
-  struct BorderedStep {
-    double ca = 0, cb = 0, dalpha = 0, dalpha2 = 0, lambda = 0;
-  };
-  bool bordered_step(double d, double m, double rtol, int k, BorderedStep& st, std::string& why);
-  bool absolute_pivots(double rtol) const;
   bool off_the_path(double rtol, double lambda) const;
   /// At the path's final state (converged to rtol): its tangent's inertia where the corrector's
   /// last factor does not give it (a kept factor, multigrid, LU). False with `why` on failure.
