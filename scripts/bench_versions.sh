@@ -9,7 +9,14 @@
 #   PRESET=random3d MESH='{degree: 2, h: 0.3}' scripts/bench_versions.sh /tmp/old/hypershape 4 25 1
 # Environment: PRESET (default random2d), SHAPES_H (shapes.h: the 2D mesh size), MESH (a mesh:
 # override, e.g. '{degree: 2}'; mesh.h is the 3D solve mesh size),
-# SOLVER (a solver: override for this build only, e.g. '{factor_reuse: false}').
+# SOLVER (a solver: override for this build only, e.g. '{factor_reuse: false}'), THIS_HYPERSHAPE
+# (this build's binary, default build/hypershape: a copy keeps a long run apart from rebuilds).
+# Where a preset changed between the versions, the same problem needs other words in each:
+# OTHER_PRESET (the other build's preset name, default PRESET), THIS_MESH (this build's mesh:
+# override, default MESH) and THIS_YAML (more top-level lines for this build only), e.g. the
+# random3d preset of 256a82b (P2, mesh.h 0.3, pointwise dilatation) against today's build:
+#   PRESET=random3d MESH='{degree: 2, h: 0.3}' THIS_MESH='{degree: 2, h: 0.3, surface_h: 0.3, rim: 0}' \
+#   THIS_YAML='material: {dilatation: pointwise}' scripts/bench_versions.sh /tmp/base256/build/hypershape 5 20 2
 # JSON: results/bench_versions.json. Build the other version with e.g.
 #   git worktree add /tmp/old HEAD~1 && (cd /tmp/old && scripts/setup.sh)
 set -euo pipefail
@@ -19,21 +26,22 @@ shapes=${2:-20} loads=${3:-50} repeats=${4:-1}
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-slice() {  # $1: file, $2: extra solver block
+slice() {  # $1: file, $2: preset, $3: mesh block, $4: solver block, $5: more lines
   {
-    echo "preset: ${PRESET:-random2d}"
+    echo "preset: $2"
     echo "name: bench_versions"
     echo "shapes: {count: $shapes${SHAPES_H:+, h: $SHAPES_H}}"
     echo "loads: {count: $loads}"
     echo "output: {shard_size: 4}"
-    if [ -n "${MESH:-}" ]; then echo "mesh: $MESH"; fi
-    if [ -n "$2" ]; then echo "solver: $2"; fi
+    if [ -n "$3" ]; then echo "mesh: $3"; fi
+    if [ -n "$4" ]; then echo "solver: $4"; fi
+    if [ -n "$5" ]; then echo "$5"; fi
   } > "$1"
 }
-slice "$work/this.yaml" "${SOLVER:-}"
-slice "$work/other.yaml" ""
+slice "$work/this.yaml" "${PRESET:-random2d}" "${THIS_MESH:-${MESH:-}}" "${SOLVER:-}" "${THIS_YAML:-}"
+slice "$work/other.yaml" "${OTHER_PRESET:-${PRESET:-random2d}}" "${MESH:-}" "" ""
 for ((k = 0; k < repeats; ++k)); do
-  build/hypershape -q generate "$work/this.yaml" --progress 0 -o "$work/this-$k" -- -log_view ":$work/this-$k.log"
+  "${THIS_HYPERSHAPE:-build/hypershape}" -q generate "$work/this.yaml" --progress 0 -o "$work/this-$k" -- -log_view ":$work/this-$k.log"
   "$other" -q generate "$work/other.yaml" --progress 0 -o "$work/other-$k" -- -log_view ":$work/other-$k.log"
   echo "run $((k + 1))/$repeats done" >&2
 done

@@ -53,6 +53,7 @@ std::string solver_text(const solver::SolverOptions& s) {
          linear +
          (s.step_growth != solver::SolverOptions{}.step_growth ? "  step_growth: " + num(s.step_growth) + "\n" : "") +
          (s.abandon_off_path ? "  abandon_off_path: true\n" : "") +  // likewise only when asked for
+         (s.absolute_pivots ? "  absolute_pivots: true\n" : "") +  // likewise (2026-11-30)
          (s.arc_length_rescue ? "  arc_length_rescue: true\n" : "") +  // only when turned on (the default since 2026-11-28)
          (s.retry_from_rest ? "" : "  retry_from_rest: false\n") +
          (s.p1_start ? "" : "  p1_start: false\n") +  // the default (2026-11-29): older identities unchanged

@@ -33,6 +33,7 @@ void parse_solver_block(const YamlBlock& sol, solver::SolverOptions& s) {
     sol.fail("step_growth", "must be 0 (by dimension: 1.5 in 2D, 2 in 3D) or in [1, 4] (the next increment's length "
                             "after an easy one, as a multiple of the last)");
   if (sol.has("abandon_off_path")) s.abandon_off_path = sol.boolean("abandon_off_path");
+  if (sol.has("absolute_pivots")) s.absolute_pivots = sol.boolean("absolute_pivots");
   if (sol.has("arc_length_rescue")) s.arc_length_rescue = sol.boolean("arc_length_rescue");
   if (sol.has("retry_from_rest")) s.retry_from_rest = sol.boolean("retry_from_rest");
   if (sol.has("p1_start")) s.p1_start = sol.boolean("p1_start");
@@ -66,7 +67,7 @@ void parse_solver_block(const YamlBlock& sol, solver::SolverOptions& s) {
   if (s.tangent.reuse && (s.tangent.linear == solver::LinearSolver::gamg || s.tangent.linear == solver::LinearSolver::hypre))
     sol.fail("factor_reuse", "must be false with linear: gamg or hypre (a kept factor is the direct solver's)");
   sol.allowed("rtol, max_newton, factor_reuse, krylov_budget, krylov_rtol, max_increments, target_rtol, control, path_rtol, newton_budget, fallback, "
-              "branch_switches, step_growth, abandon_off_path, arc_length_rescue, retry_from_rest, p1_start, local_relaxation, predictor, corrector, linear, linear_auto_dofs, factor_precision");
+              "branch_switches, step_growth, abandon_off_path, absolute_pivots, arc_length_rescue, retry_from_rest, p1_start, local_relaxation, predictor, corrector, linear, linear_auto_dofs, factor_precision");
   sol.check_all_used();
 }
 

@@ -6,14 +6,15 @@ namespace hypershape::factory {
 
 namespace {
 
-constexpr std::size_t kCounters = 11;
+constexpr std::size_t kCounters = 12;
 
 /// The counters in one fixed order (C: SolveCounters or const SolveCounters).
 template <class C>
 auto fields(C& c) {
   return std::array{&c.loads_ok, &c.loads_failed, &c.newton_iterations, &c.solves, &c.failed_increments,
           &c.off_path_increments, &c.recovery_iterations, &c.linear.numeric_factorizations,
-          &c.linear.symbolic_factorizations, &c.linear.krylov_iterations, &c.linear.tangent_assemblies};
+          &c.linear.symbolic_factorizations, &c.linear.krylov_iterations, &c.linear.tangent_assemblies,
+          &c.linear.modified_solves};
 }
 
 }  // namespace
@@ -52,7 +53,8 @@ nlohmann::json SolveCounters::solver_json() const {
           {"numeric_factorizations", linear.numeric_factorizations},
           {"symbolic_factorizations", linear.symbolic_factorizations},
           {"krylov_iterations", linear.krylov_iterations},
-          {"tangent_assemblies", linear.tangent_assemblies}};
+          {"tangent_assemblies", linear.tangent_assemblies},
+          {"modified_newton_solves", linear.modified_solves}};
 }
 
 }  // namespace hypershape::factory

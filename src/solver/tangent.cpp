@@ -16,6 +16,7 @@ LinearCounters& LinearCounters::operator+=(const LinearCounters& o) {
   symbolic_factorizations += o.symbolic_factorizations;
   krylov_iterations += o.krylov_iterations;
   tangent_assemblies += o.tangent_assemblies;
+  modified_solves += o.modified_solves;
   return *this;
 }
 
@@ -25,6 +26,7 @@ LinearCounters LinearCounters::operator-(const LinearCounters& o) const {
   d.symbolic_factorizations -= o.symbolic_factorizations;
   d.krylov_iterations -= o.krylov_iterations;
   d.tangent_assemblies -= o.tangent_assemblies;
+  d.modified_solves -= o.modified_solves;
   return d;
 }
 
@@ -222,6 +224,7 @@ bool Tangent::solve_pair(Vec b1, Vec x1, bool guess1, Vec b2, Vec x2, bool absol
   if (multigrid() || opt_.reuse) return solve(b1, x1, guess1) && solve(b2, x2, false);
   if (!current_ && !factorise()) return false;
   LogEvent e(events().factor_solve);
+  if (absolute && factor().has_absolute()) ++n_.modified_solves;
   return factor().solve_pair(b1, x1, b2, x2, absolute);
 }
 

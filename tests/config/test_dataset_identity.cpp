@@ -48,7 +48,7 @@ shapes:
   count: 4
 seed: 3
 name: same
-solver: {rtol: 1.0e-9, linear: auto, step_growth: 0, abandon_off_path: false, arc_length_rescue: false, retry_from_rest: true, predictor: second_order, corrector: chebyshev, local_relaxation: true}
+solver: {rtol: 1.0e-9, linear: auto, step_growth: 0, abandon_off_path: false, absolute_pivots: false, arc_length_rescue: false, retry_from_rest: true, predictor: second_order, corrector: chebyshev, local_relaxation: true}
 petsc: {}
 preset: random2d
 )") == a);
@@ -64,7 +64,8 @@ TEST_CASE("a different value is a different dataset", "[config][identity]") {
   for (const char* change : {"seed: 4\n", "loads: {count: 3, target: [0.1, 0.4]}\n", "material: {E: 501}\n",
                              "mesh: {degree: 1}\n", "mesh: {quadrature: 2}\n", "petsc: {pc_type: lu}\n", "output: {shard_size: 2}\n",
                              "solver: {linear: gamg}\n", "solver: {linear_auto_dofs: 1000}\n",
-                             "solver: {abandon_off_path: true}\n", "solver: {arc_length_rescue: true}\n",
+                             "solver: {abandon_off_path: true}\n", "solver: {absolute_pivots: true}\n",
+                             "solver: {arc_length_rescue: true}\n",
                              "solver: {retry_from_rest: false}\n",
                              "solver: {step_growth: 2}\n", "solver: {predictor: tangent}\n",
                              "solver: {corrector: newton}\n", "solver: {local_relaxation: false}\n"}) {

@@ -488,3 +488,42 @@ TEST_CASE("Replay a failed load case from the P1 solution on the same mesh", "[.
   const auto r = from_p1(c, ns, load);
   if (r && r->converged) hstest::check_stable_on_target(*c.sp.problem, ns.solution(), *r, c.loads[std::size_t(load)].target, c.cfg.solver);
 }
+
+TEST_CASE("solver.absolute_pivots: modified Newton steps where the line search cut Newton's, the same equilibrium",
+          "[stability][modified_newton]") {
+  // Random2D preset (P2, graded), seed 2024, shape 2, load 8, solved alone: by default no solve
+  // with U^T |D| U; with the key (or the PETSc option -path_absolute_pivots, its alias for
+  // replays) an intermediate iterate with negative pivots whose step was cut below 0.3 steps
+  // again with it (Tangent counts each such solve). The load case must still end stable on
+  // target, in the equilibrium a load-controlled solve from rest to the same alpha reaches.
+  Case c(2024, 2, HS_SOURCE_DIR "/configs/presets/random2d.yaml", 0, 0, 25);
+  const auto& lc = c.set(8);
+  {
+    solver::NonlinearSolver by_default(*c.sp.problem, c.cfg.solver);
+    CHECK(by_default.solve_for_target(lc.target).linear.modified_solves == 0);
+  }
+  {
+    HS_PETSC(PetscOptionsSetValue(nullptr, "-path_absolute_pivots", "true"));
+    solver::NonlinearSolver by_option(*c.sp.problem, c.cfg.solver);
+    const auto r = by_option.solve_for_target(lc.target);
+    HS_PETSC(PetscOptionsClearValue(nullptr, "-path_absolute_pivots"));
+    CHECK(r.linear.modified_solves > 0);
+  }
+  solver::SolverOptions opt = c.cfg.solver;
+  opt.absolute_pivots = true;
+  solver::NonlinearSolver ns(*c.sp.problem, opt);
+  const auto r = ns.solve_for_target(lc.target);
+  INFO(r.reason << ", " << r.newton_iterations << " Newton its, " << r.linear.modified_solves << " modified solves");
+  CHECK(r.linear.modified_solves > 0);
+  hstest::check_stable_on_target(*c.sp.problem, ns.solution(), r, lc.target, opt);
+  core::VecH path = c.sp.problem->create_vector();
+  HS_PETSC(VecCopy(ns.solution(), path));
+  ns.reset();
+  const solver::SolveResult direct = ns.solve(r.alpha);
+  REQUIRE(direct.converged);
+  HS_PETSC(VecAXPY(path, -1.0, ns.solution()));
+  PetscReal diff, norm;
+  HS_PETSC(VecNorm(path, NORM_INFINITY, &diff));
+  HS_PETSC(VecNorm(ns.solution(), NORM_INFINITY, &norm));
+  CHECK(diff <= 1e-7 * norm);
+}

@@ -113,6 +113,12 @@ struct SolverOptions {
   /// the path (off_the_path) instead of letting Newton creep there. Off by default: it saves a
   /// tenth of the Newton iterations of Random2D P2 paths, but loses load cases at bifurcations.
   bool abandon_off_path = false;
+  /// Displacement control: where the line search cut an intermediate iterate's Newton step below
+  /// 0.3 at an indefinite tangent, step once more with U^T |D| U (absolute_pivots(); 2D blocked
+  /// factors). Off by default: every load case with a stable state on its path converged on three
+  /// unseen seeds (1000 / 998 / 998 against 999 / 998 / 998) for 1-2% more Newton iterations
+  /// (docs/STABILITY.md, "Modified Newton"). Also set by the PETSc option -path_absolute_pivots.
+  bool absolute_pivots = false;
   /// Displacement control failed and the branch switches did not help (not at a verified fold):
   /// follow the path once more from rest by arc-length continuation (the constraint on the step
   /// along the path's own direction instead of on max|u|), which passes the points where max|u|

@@ -54,6 +54,9 @@ struct LinearCounters {
   std::int64_t symbolic_factorizations = 0;
   std::int64_t krylov_iterations = 0;
   std::int64_t tangent_assemblies = 0;
+  /// Solves with U^T |D| U instead of the factor itself (the corrector's modified Newton steps,
+  /// solver.absolute_pivots): each is a pair of triangular solves, no factorisation.
+  std::int64_t modified_solves = 0;
   LinearCounters& operator+=(const LinearCounters& o);
   LinearCounters operator-(const LinearCounters& o) const;
 };
