@@ -203,13 +203,15 @@ std::string petsc_help_intro() {
       "  solver:  rtol {:g}, max_newton {}, max_increments {}, target_rtol {:g}, control displacement|load "
       "({}), path_rtol {:g},\n"
       "           newton_budget {}, fallback {}, branch_switches {}, step_growth {:g} (0: by dimension), "
-      "abandon_off_path {}, absolute_pivots {}, factor_reuse {}, krylov_budget {} (0: by dimension), krylov_rtol {:g},\n"
+      "abandon_off_path {}, absolute_pivots {},\n"
+      "           factor_reuse {}, krylov_budget {} (0: by dimension), krylov_rtol {:g},\n"
       "           linear auto|direct|gamg|hypre ({}; auto: gamg in 3D from linear_auto_dofs {} unknowns)\n"
       "  petsc:   any PETSc option listed below, without the dash (the command line wins)\n"
       "  `hypershape effects` lists the effects a scene may use.\n",
       d.rtol, d.max_newton, d.max_increments, d.target_rtol,
       d.control == solver::Control::displacement ? "displacement" : "load", d.path_rtol, d.newton_budget,
-      d.fallback, d.branch_switches, d.step_growth, d.abandon_off_path, d.absolute_pivots, d.tangent.reuse, d.tangent.krylov_budget,
+      d.fallback, d.branch_switches, d.step_growth, d.abandon_off_path, d.absolute_pivots, d.tangent.reuse,
+      d.tangent.krylov_budget,
       d.tangent.krylov_rtol,
       solver::to_string(d.tangent.linear), d.tangent.auto_dofs);
 }

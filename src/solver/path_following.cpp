@@ -240,13 +240,13 @@ bool NonlinearSolver::bordered_step(double d, double m, double rtol, int k, Bord
 }
 
 bool NonlinearSolver::absolute_pivots(double rtol) const {
-  // Opt-in (solver.absolute_pivots or -path_absolute_pivots; docs/STABILITY.md, "Modified Newton"): an intermediate
-  // iterate whose tangent is indefinite and whose Newton step the line search cut below 0.3
-  // (no descent direction of the energy there: the cells at a clamp's end compressed past what
-  // they allow) steps again with U^T |D| U, the same factor with its indefinite 2x2 pivots made
-  // positive (Gill, Murray & Wright, Practical Optimization, 4.4.2): a descent direction, one
-  // more pair of triangular solves. Not on the last increment: its state on target is reached
-  // and classified (stable, or a fold).
+  // Opt-in (solver.absolute_pivots, or -path_absolute_pivots, which wins; docs/STABILITY.md,
+  // "Modified Newton"): an intermediate iterate whose tangent is indefinite and whose Newton step
+  // the line search cut below 0.3 (no descent direction of the energy there: the cells at a
+  // clamp's end compressed past what they allow) steps again with U^T |D| U, the same factor with
+  // its indefinite 2x2 pivots made positive (Gill, Murray & Wright, Practical Optimization,
+  // 4.4.2): a descent direction, one more pair of triangular solves. Not on the last increment:
+  // its state on target is reached and classified (stable, or a fold).
   PetscBool on = opt_.absolute_pivots ? PETSC_TRUE : PETSC_FALSE;
   PetscOptionsGetBool(nullptr, nullptr, "-path_absolute_pivots", &on, nullptr);
   return on && rtol > opt_.rtol && negative_pivots_ > 0 && tangent_->absolute_solves();
