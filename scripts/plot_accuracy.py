@@ -54,7 +54,10 @@ TIME_KEY = "seconds"  # or "cpu_seconds" (--time cpu)
 
 
 def aggregate(study, dim):
-    """Per setting name: mean metrics over every (scene, load case) of the dimension."""
+    """Per setting name: mean metrics over every (scene, load case) of the dimension. A setting
+    that ran on only some of the scenes (a knob of one scene's own baseline, e.g. easy-0's P2)
+    is marked incomplete: its means are over other scenes than the rest's, so the fronts and
+    findings leave it out, and the table names its scenes."""
     rows = {}
     refs = []
     kinds = {}
@@ -73,7 +76,8 @@ def aggregate(study, dim):
             s = r["setting"]
             row = rows.setdefault(s["name"], {"setting": s, "l2": [], "h1": [], "alpha": [], "solver": [], "same": [],
                                              "sec": [], "sec_am": [], "dofs": [], "rss": [], "failed": 0,
-                                             "n": 0, "scenes": {}, "errors": []})
+                                             "n": 0, "scenes": {}, "errors": [], "covers": set()})
+            row["covers"].add(sc["name"])
             if "error" in r:
                 row["errors"].append(f"{sc['name']}: {r['error']}")
                 row["failed"] += len(sc["load_cases"])
@@ -113,7 +117,8 @@ def aggregate(study, dim):
                     "same": m(row["same"]) if len(row["same"]) == len(row["l2"]) else float("nan"),
                     "same_worst_scene": worst_scene(row["scenes"], kinds),
                     "sec": m(row["sec"]), "sec_am": m(row["sec_am"]), "dofs": m(row["dofs"]),
-                    "rss": max(row["rss"]) if row["rss"] else float("nan"), "scenes": row["scenes"]})
+                    "rss": max(row["rss"]) if row["rss"] else float("nan"), "scenes": row["scenes"],
+                    "covers": sorted(row["covers"]), "complete": row["covers"] == set(kinds)})
     return out, refs
 
 
@@ -266,9 +271,10 @@ def report(study, dims, fig_dir, suffix, table_dir):
     lines.append("")
     findings = {}
     for dim in dims:
-        rows, refs = aggregate(study, dim)
-        if not rows:
+        listed, refs = aggregate(study, dim)
+        if not listed:
             continue
+        rows = [r for r in listed if r["complete"]]  # compared over the same scenes
         front = pareto(rows)
         front_names = {r["name"] for r in front}
         front_same = pareto(rows, key_e="same")
@@ -291,8 +297,10 @@ def report(study, dims, fig_dir, suffix, table_dir):
         lines.append("| setting | group | DoFs | time/load | amortised | rel L2 | rel H1 | alpha err | same-load L2 | "
                      "solver err | peak RSS +MiB | front | front (same load) |")
         lines.append("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
-        for r in sorted(rows, key=lambda r: (not r["ok"], r["sec"] if math.isfinite(r["sec"]) else 1e99)):
-            name = r["name"] + (" **(default)**" if r["default"] else "")
+        for r in sorted(listed, key=lambda r: (not r["ok"], r["sec"] if math.isfinite(r["sec"]) else 1e99)):
+            name = r["name"] + (" **(default)**" if r["default"] and r["complete"] else "")
+            if not r["complete"]:
+                name += f" [{', '.join(r['covers'])} only: not on the fronts]"
             if not r["ok"]:
                 name += f" (failed {r['failed']}/{r['n']})"
             lines.append(f"| {name} | {r['group']} | {r['dofs']:.0f} | {fmt_t(r['sec'])} | {fmt_t(r['sec_am'])} | "
@@ -309,7 +317,7 @@ def report(study, dims, fig_dir, suffix, table_dir):
         lines.append("|---|" + "---|" * len(scenes))
         lines.append("| reference's own (Richardson) | " + " | ".join(
             f"{fmt_e(x['l2'])} / {fmt_e(x['alpha'])} / -" for x in refs) + " |")
-        for r in sorted(rows, key=lambda r: (r["group"] != "mesh", r["setting"]["degree"], -r["setting"]["h"])):
+        for r in sorted(listed, key=lambda r: (r["group"] != "mesh", r["setting"]["degree"], -r["setting"]["h"])):
             if r["group"] not in ("mesh", "linear_model"):
                 continue
             cells = []
@@ -401,7 +409,7 @@ def report(study, dims, fig_dir, suffix, table_dir):
                 lines.append(f"- {len(same)} settings give the default's error to 3 digits with the default's linear "
                              f"solver ({', '.join(r['name'] for r in same)}); their times spread over {fmt_t(ts[0])} .. "
                              f"{fmt_t(ts[-1])}: time differences of that size are noise here, not cost.")
-        failed = [r for r in rows if not r["ok"]]
+        failed = [r for r in listed if not r["ok"]]
         for r in failed:
             lines.append(f"- failed: {r['name']}: {r['failed']}/{r['n']} load cases; "
                          f"{'; '.join(sorted(set(r['errors']))[:3])}")

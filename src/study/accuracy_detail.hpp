@@ -119,6 +119,7 @@ struct LoadOutcome {
   std::vector<double> cpu_seconds_all;  ///< process CPU time of the same runs
   double cpu_seconds = NAN;
   int newton = 0, solves = 0, failed_increments = 0;
+  std::vector<int> newton_all;  ///< Newton iterations of each repeat (equal: each from the same hint)
   std::vector<double> u;  ///< gathered nodal displacement (canonical order)
 };
 

@@ -228,6 +228,7 @@ json load_json(const LoadOutcome& lo) {
           {"cpu_seconds", number_or_null(lo.cpu_seconds)},
           {"cpu_seconds_all", lo.cpu_seconds_all},
           {"newton", lo.newton},
+          {"newton_all", lo.newton_all},
           {"solves", lo.solves},
           {"failed_increments", lo.failed_increments}};
 }

@@ -93,15 +93,18 @@ struct Solving {
   Vec du;
 };
 
-/// One load case, `repeats` times (fewer after a failure or a run longer than repeat_above):
-/// the medians of the wall and CPU times, and the gathered displacement.
+/// One load case, `repeats` times (fewer after a failure or a run longer than repeat_above), each
+/// from the first-increment hint the first one had: the medians of the wall and CPU times, and
+/// the gathered displacement.
 LoadOutcome solve_load(Solving& w, const factory::LoadCase& lc, int repeats, double repeat_above) {
   const physics::Problem& problem = *w.sp.problem;
   LoadOutcome lo;
+  const double hint = w.nl.step_hint();  // the previous load case's, as the factory would see it
   for (int r = 0; r < repeats; ++r) {
     const double t1 = core::now_seconds(), c1 = cpu_seconds();
     w.sp.set_load_case(w.cfg, w.shape, lc);
     w.nl.reset();
+    w.nl.set_step_hint(hint);
     if (w.s.linear_model)
       linear_model(w.nl, problem, lc.target, w.du, lo);
     else
@@ -109,6 +112,7 @@ LoadOutcome solve_load(Solving& w, const factory::LoadCase& lc, int repeats, dou
     const double t = core::now_seconds() - t1;
     lo.seconds_all.push_back(t);
     lo.cpu_seconds_all.push_back(cpu_seconds() - c1);
+    lo.newton_all.push_back(lo.newton);
     if (!lo.converged || t > repeat_above) break;
   }
   lo.seconds = median(lo.seconds_all);

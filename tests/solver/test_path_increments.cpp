@@ -228,3 +228,30 @@ TEST_CASE("Step control: growing, halving, and a creeping corrector given up", "
   CHECK_FALSE(creeps(10, {{0.1, 8}, {0.1, 6}, {0.1, 4.9}}));
   CHECK(creeps(10, {{0.1, 8}, {0.1, 6}, {0.1, 4.9}, {0.1, 4.1}}));
 }
+
+TEST_CASE("The first-increment hint: kept by reset, and set back so that a repeat solves as the first did",
+          "[solver]") {
+  // A load case repeated with the hint its own first try left (the first increment that
+  // converged, after the failed longer ones) skips those failures: a timing study that repeats a
+  // load case (study_accuracy's solve_load) sets the hint back before each repeat, or it times a
+  // path the factory never takes.
+  physics::Problem p{PETSC_COMM_WORLD, hstest::disk_mesh(0.05), hstest::disk_effects(500, 0.49), hstest::degree(1)};
+  solver::NonlinearSolver ns(p, solver::SolverOptions{});
+  REQUIRE(ns.step_hint() == 0);  // no earlier load case: the first try is the whole target
+  const solver::TargetResult first = ns.solve_for_target(1.2);
+  REQUIRE(first.converged);
+  REQUIRE(first.failed_increments > 0);  // the whole target at once failed
+  ns.reset();
+  CHECK(ns.step_hint() > 0);  // kept by reset: the first increment that converged
+  const solver::TargetResult self_hinted = ns.solve_for_target(1.2);
+  REQUIRE(self_hinted.converged);
+  INFO("first " << first.newton_iterations << " its, " << first.failed_increments << " failed; self-hinted "
+                << self_hinted.newton_iterations << ", " << self_hinted.failed_increments << " failed");
+  CHECK(self_hinted.newton_iterations < first.newton_iterations);
+  ns.reset();
+  ns.set_step_hint(0);
+  const solver::TargetResult repeat = ns.solve_for_target(1.2);
+  CHECK(repeat.newton_iterations == first.newton_iterations);
+  CHECK(repeat.failed_increments == first.failed_increments);
+  CHECK(repeat.alpha == first.alpha);
+}

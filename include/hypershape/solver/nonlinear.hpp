@@ -244,8 +244,14 @@ class NonlinearSolver {
   /// The current (last converged) displacement, a global vector.
   Vec solution() const { return u_.get(); }
   double load_factor() const { return s_; }
-  /// Back to u = 0 at load factor 0.
+  /// Back to u = 0 at load factor 0 (the first-increment hint is kept: the next load case of a
+  /// shape starts from the last one's first increment, as in the factory).
   void reset();
+  /// That hint (0: none). A timing study sets it back before repeating a load case, so that every
+  /// repeat solves as the first did (a load case hinted by its own first increment reaches its
+  /// target in one increment: not the factory's cost).
+  double step_hint() const { return step_hint_; }
+  void set_step_hint(double hint) { step_hint_ = hint; }
   /// solve_for_target() from the state u (a global vector of the problem, e.g. another
   /// discretisation's solution) at load factor s instead of from rest: the path continues from
   /// there, then the branch switches as after any path (no retry from rest). The next load
