@@ -6,7 +6,7 @@
 # reference's Richardson estimate (and its observed order) is reported and finite; the C++
 # metrics agree with scripts/hypershape_data.py's rel_l2 / rel_h1 to round-off on the dumped
 # arrays; the JSON, the markdown table and the Pareto PNG exist; an unwritable --out stops it
-# before any work.
+# before any work; a setting run on one scene of two is listed with its scene and kept off the fronts.
 # Needs HYPERSHAPE_BIN (the study binary sits beside it) and HYPERSHAPE_SOURCE_DIR (set by CTest).
 set -u
 bin_dir=$(dirname "${HYPERSHAPE_BIN:?}")
@@ -36,7 +36,7 @@ if ! /usr/bin/python3 "$src/scripts/plot_accuracy.py" "$work/study.json" --fig-d
   echo "FAIL: plot_accuracy.py"; exit 1
 fi
 
-PYTHONPATH="$src/scripts" /usr/bin/python3 - "$work" <<'PY'
+SRC="$src" PYTHONPATH="$src/scripts" /usr/bin/python3 - "$work" <<'PY'
 import json, math, os, sys
 import numpy as np
 import hypershape_data as hd
@@ -111,6 +111,27 @@ assert open(png, "rb").read(8) == b"\x89PNG\r\n\x1a\n"
 md = open(f"{work}/study.md").read()
 assert "Pareto front" in md and "P1 h0.04 **(default)**" in md, md[:2000]
 print("plot and table written")
+
+# A setting run on one scene only (a knob of that scene's own baseline) is not compared with
+# means over every scene: listed with its scene, off the fronts. The study with a second copy
+# of the disk whose fastest setting is renamed, so that each of the two names covers one scene.
+import copy, subprocess
+two = copy.deepcopy(s)
+other = copy.deepcopy(sc)
+other["name"] = "disk-b"
+fast = min((r for r in other["results"] if "error" not in r), key=lambda r: r["loads"][0]["seconds"])
+lone = fast["setting"]["name"]
+fast["setting"] = dict(fast["setting"], name=lone + " alone")
+two["scenes"].append(other)
+json.dump(two, open(f"{work}/two.json", "w"))
+subprocess.run(["/usr/bin/python3", f"{os.environ['SRC']}/scripts/plot_accuracy.py", f"{work}/two.json",
+                "--fig-dir", f"{work}/fig2", "--table", f"{work}/two.md"], check=True, stdout=subprocess.DEVNULL)
+md2 = open(f"{work}/two.md").read()
+fr = json.load(open(f"{work}/two_findings.json"))["2"]
+assert f"{lone} alone [disk-b only: not on the fronts]" in md2, md2[:3000]
+assert f"{lone} [disk only: not on the fronts]" in md2, md2[:3000]
+assert lone not in fr["front"] and lone + " alone" not in fr["front"], fr["front"]
+print(f"a setting on one scene of two ({lone}) is listed with its scene and left off the fronts")
 PY
 rc=$?
 [ $rc -eq 0 ] && echo "PASS" || echo "FAIL"
