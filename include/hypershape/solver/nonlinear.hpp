@@ -248,8 +248,8 @@ class NonlinearSolver {
   /// shape starts from the last one's first increment, as in the factory).
   void reset();
   /// That hint (0: none). A timing study sets it back before repeating a load case, so that every
-  /// repeat solves as the first did (a load case hinted by its own first increment reaches its
-  /// target in one increment: not the factory's cost).
+  /// repeat solves as the first did (a load case hinted by its own first increment skips the
+  /// failed first tries the first run paid: not the factory's cost).
   double step_hint() const { return step_hint_; }
   void set_step_hint(double hint) { step_hint_ = hint; }
   /// solve_for_target() from the state u (a global vector of the problem, e.g. another
@@ -392,8 +392,8 @@ class NonlinearSolver {
   /// (`m` = c . u_) and its line search (the trial in w_, its residual in b_); taken again with
   /// U^T |D| U where absolute_pivots() says so. False with `why` on a singular system or failed solve.
   bool bordered_step(double d, double m, double rtol, int k, BorderedStep& st, std::string& why);
-  /// -path_absolute_pivots (opt-in), an intermediate increment (`rtol` above the final one), an
-  /// indefinite tangent and a factor that can solve with |D|.
+  /// solver.absolute_pivots or -path_absolute_pivots (opt-in; the option wins), an intermediate
+  /// increment (`rtol` above the final one), an indefinite tangent and a factor that can solve with |D|.
   bool absolute_pivots(double rtol) const;
   /// With abandon_off_path: whether a corrector iterate of an intermediate increment (`rtol` above
   /// the final one), on the increment's first try, has left the path: its tangent has more
