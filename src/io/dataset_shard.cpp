@@ -5,13 +5,13 @@
 #include <hdf5.h>
 #include <sys/statvfs.h>
 #include <unistd.h>
-#include <zlib.h>
 
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <numeric>
 
+#include "chunk_deflate.hpp"
 #include "h5_util.hpp"
 #include "hypershape/core/interrupt.hpp"
 #include "shape_group.hpp"
@@ -51,8 +51,8 @@ void write_array(hid_t g, const Array& a) {
   if (size != n) throw std::runtime_error(fmt::format("array {}: {} values for shape of {}", a.name, size, n));
   Id space{check_id(H5Screate_simple(rank, dims.data(), nullptr), a.name), H5Sclose};
   Id dcpl = untimed(H5P_DATASET_CREATE);
+  std::vector<hsize_t> chunk = dims;
   if (n > 0) {
-    std::vector<hsize_t> chunk = dims;
     if (a.name.rfind("loads/", 0) == 0 && rank >= 2) {
       chunk[0] = 1;  // one load case per chunk: a training sample reads one chunk
     } else {
@@ -61,12 +61,12 @@ void write_array(hid_t g, const Array& a) {
     }
     check(H5Pset_chunk(dcpl.id, rank, chunk.data()), a.name);
     check(H5Pset_shuffle(dcpl.id), a.name);
-    check(H5Pset_deflate(dcpl.id, 4), a.name);
+    check(H5Pset_deflate(dcpl.id, kDeflateLevel), a.name);
   }
   Id lcpl{check_id(H5Pcreate(H5P_LINK_CREATE), a.name), H5Pclose};
   check(H5Pset_create_intermediate_group(lcpl.id, 1), a.name);
   Id ds{check_id(H5Dcreate2(g, a.name.c_str(), type, space.id, lcpl.id, dcpl.id, H5P_DEFAULT), a.name), H5Dclose};
-  if (n > 0) check(H5Dwrite(ds.id, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), a.name);
+  if (n > 0) write_deflated_chunks(ds.id, data, dims, chunk, elem);
   if (!a.meaning.empty()) attr_string(ds.id, "meaning", a.meaning);
   if (!a.units.empty()) attr_string(ds.id, "units", a.units);
 }
@@ -326,14 +326,14 @@ ShardSummary read_shard_summary(const std::string& path) {
 std::uint32_t file_crc32(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error("cannot read " + path);
-  uLong crc = crc32(0L, Z_NULL, 0);
+  std::uint32_t crc = 0;
   std::vector<char> buf(1 << 20);
   while (in) {
     in.read(buf.data(), std::streamsize(buf.size()));
     const auto n = in.gcount();
-    if (n > 0) crc = crc32(crc, reinterpret_cast<const Bytef*>(buf.data()), uInt(n));
+    if (n > 0) crc = crc32_update(crc, buf.data(), std::size_t(n));
   }
-  return std::uint32_t(crc);
+  return crc;
 }
 
 std::string text_digest(const std::string& text) {
