@@ -3,7 +3,9 @@
 # seconds per load case, numeric factorisations, Krylov and Newton iterations per load case
 # (factorisations from the run report's solver.numeric_factorizations where a build writes it,
 # else PETSc's log: MatCholFctrNum plus HSFactorBlocked; Krylov: KSPGMRESOrthog), the converged share, and how
-# far the two datasets' displacements are apart on the load cases both converged.
+# far the two datasets' displacements are apart on the load cases both converged,
+# and the run reports' phases side by side (shape, mesh, solve, alpha search, representations, io):
+# seconds per 100 load cases, medians over the runs.
 #   scripts/bench_versions.sh OTHER_HYPERSHAPE [SHAPES] [LOADS] [REPEATS]
 #   SHAPES_H=0.12 MESH='{degree: 2}' scripts/bench_versions.sh /tmp/old/hypershape 8 25 1
 #   PRESET=random3d MESH='{degree: 2, h: 0.3}' scripts/bench_versions.sh /tmp/old/hypershape 4 25 1
@@ -69,10 +71,18 @@ def run(tag, k):
                 "numeric_factorizations", count(log, "MatCholFctrNum") + count(log, "HSFactorBlocked")) / lc,
             "krylov_iterations_per_load_case": count(log, "KSPGMRESOrthog") / lc,
             "newton_iterations_per_load_case": rep["solver"]["newton_iterations"] / lc,
-            "factorization_seconds_per_load_case": rep["seconds"]["factorization_PCSetUp_summed_over_ranks"] / lc}
+            "factorization_seconds_per_load_case": rep["seconds"]["factorization_PCSetUp_summed_over_ranks"] / lc,
+            # Where the time went: the run report's phases (shape, mesh, solve, io, ...), per load case.
+            "phase_seconds_per_load_case": {k: v / lc for k, v in
+                                            rep["seconds"].get("phases_summed_over_groups", {}).items()}}
 
 runs = {t: [run(t, k) for k in range(repeats)] for t in ("this", "other")}
-med = {t: {key: statistics.median(r[key] for r in runs[t]) for key in runs[t][0]} for t in runs}
+med = {t: {key: statistics.median(r[key] for r in runs[t]) for key in runs[t][0]
+           if key != "phase_seconds_per_load_case"} for t in runs}
+for t in runs:  # a phase's median over the runs (a phase one build does not have counts as 0)
+    names = sorted({p for r in runs[t] for p in r["phase_seconds_per_load_case"]})
+    med[t]["phase_seconds_per_load_case"] = {
+        p: statistics.median(r["phase_seconds_per_load_case"].get(p, 0.0) for r in runs[t]) for p in names}
 
 # The datasets, load case by load case (first repeat): displacement of the cases both converged.
 diffs, only = [], {"this": 0, "other": 0}
@@ -106,6 +116,12 @@ for t, name in (("this", "this build"), ("other", other)):
           f"| {m['factorization_seconds_per_load_case']:.4f} | {m['converged']}/{m['load_cases']} |")
 ratio = med["other"]["seconds_per_load_case"] / med["this"]["seconds_per_load_case"]
 print(f"speed-up (other / this, seconds per load case): {ratio:.2f}x")
+ph = {t: med[t]["phase_seconds_per_load_case"] for t in med}
+print("\n| phase (medians) | this: s / 100 load cases | other | other / this |\n|---|---|---|---|")
+for p in sorted(set(ph["this"]) | set(ph["other"])):
+    a, b = 100 * ph["this"].get(p, 0.0), 100 * ph["other"].get(p, 0.0)
+    if a > 0.005 or b > 0.005:
+        print(f"| {p} | {a:.2f} | {b:.2f} | {b / a:.2f}x |" if a > 0 else f"| {p} | {a:.2f} | {b:.2f} | - |")
 u = out["u_rel_diff"]
 print(f"displacement, load cases converged in both ({u['both_converged']}): max|u_this - u_other| / max|u_other| "
       f"median {u['median']:.1e}, max {u['max']:.1e}; {u['above_1e-6']} above 1e-6 (another equilibrium of the same "
