@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "chunk_deflate.hpp"
+
 namespace hypershape::io {
 
 inline void check(herr_t status, const std::string& what) {
@@ -35,17 +37,19 @@ inline Id untimed(hid_t cls) {
   return p;
 }
 
+/// A rows x cols array, chunked by 16384 rows, shuffled and deflated as the shards' arrays are
+/// (chunk_deflate.hpp).
 inline void write_2d(hid_t parent, const char* name, hid_t type, const void* data, hsize_t rows, hsize_t cols) {
-  hsize_t dims[2] = {rows, cols};
-  Id space{check_id(H5Screate_simple(2, dims, nullptr), name), H5Sclose};
+  const std::vector<hsize_t> dims{rows, cols}, chunk{std::min<hsize_t>(rows, 16384), cols};
+  Id space{check_id(H5Screate_simple(2, dims.data(), nullptr), name), H5Sclose};
   Id plist = untimed(H5P_DATASET_CREATE);
   if (rows > 0) {
-    hsize_t chunk[2] = {std::min<hsize_t>(rows, 16384), cols};
-    check(H5Pset_chunk(plist.id, 2, chunk), name);
-    check(H5Pset_deflate(plist.id, 4), name);
+    check(H5Pset_chunk(plist.id, 2, chunk.data()), name);
+    check(H5Pset_shuffle(plist.id), name);
+    check(H5Pset_deflate(plist.id, kDeflateLevel), name);
   }
   Id ds{check_id(H5Dcreate2(parent, name, type, space.id, H5P_DEFAULT, plist.id, H5P_DEFAULT), name), H5Dclose};
-  if (rows > 0) check(H5Dwrite(ds.id, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), name);
+  if (rows > 0) write_deflated_chunks(ds.id, data, dims, chunk, H5Tget_size(type));
 }
 
 inline void attr_double(hid_t obj, const std::string& name, double v) {

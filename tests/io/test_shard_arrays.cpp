@@ -1,7 +1,7 @@
-// A shard's arrays are compressed here (shuffle and DEFLATE by libdeflate, the chunks written
-// as stored) and read by HDF5's own filters: every value comes back, each dataset declares the
-// standard filters, a chunk past the end of an array (its tail padding) reads as the array, and
-// the file checksum is CRC-32 as zlib computes it.
+// A shard's arrays, and its shape group's, are compressed here (shuffle and DEFLATE by
+// libdeflate, the chunks written as stored) and read by HDF5's own filters: every value comes
+// back, each dataset declares the standard filters, a chunk past the end of an array (its tail
+// padding) reads as the array, and the file checksum is CRC-32 as zlib computes it.
 #include <hdf5.h>
 
 #include <catch2/catch.hpp>
@@ -58,6 +58,8 @@ TEST_CASE("Shard arrays compressed by the writer read back through HDF5's filter
   io::ShardShape s;
   s.shape.shape_id = 7;
   s.shape.dirichlet_center = {0, 0, 0};
+  s.shape.mesh_nodes = {0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 1.0};  // the shape group's arrays (write_2d)
+  s.shape.mesh_cells = {0, 1, 2, 1, 3, 2};
   // 600,000 doubles: chunks of 2^20 / 2 rows, so the second chunk runs past the array's end.
   std::vector<double> big(600000);
   for (std::size_t i = 0; i < big.size(); ++i) big[i] = std::sin(0.001 * double(i)) * 1e3 + double(i % 7);
@@ -87,6 +89,9 @@ TEST_CASE("Shard arrays compressed by the writer read back through HDF5's filter
   CHECK(dims == std::vector<hsize_t>{3, 5, 4, 3});
   CHECK((read_all<std::int64_t>(f, "shapes/000007/cells", H5T_NATIVE_INT64, dims) == cells));
   CHECK((read_all<std::int8_t>(f, "shapes/000007/grid/inside", H5T_NATIVE_INT8, dims) == inside));
+  CHECK((read_all<double>(f, "shapes/000007/mesh/nodes", H5T_NATIVE_DOUBLE, dims) == s.shape.mesh_nodes));
+  CHECK(dims == std::vector<hsize_t>{4, 2});
+  CHECK((read_all<std::int64_t>(f, "shapes/000007/mesh/cells", H5T_NATIVE_INT64, dims) == s.shape.mesh_cells));
   H5Fclose(f);
   // The check value of CRC-32 (zlib's, and Python's zlib.crc32 that hypershape_data.py checks).
   const std::string digits = (dir / "digits").string();
