@@ -26,7 +26,7 @@ PACKAGES=(
   libcli11-dev                      # command-line parsing
   libfmt-dev                        # formatting (GCC 12 has no <format>)
   nlohmann-json3-dev                # JSON reports and benchmarks
-  libdeflate-dev                    # DEFLATE of the shards' chunks (twice zlib's speed) and their CRC-32
+  libdeflate-dev                    # DEFLATE of the HDF5 arrays' chunks (twice zlib's speed), the shards' CRC-32
   libcgal-dev                       # CGAL: AABB trees (distances), self-intersection checks, surface remeshing
   python3-h5py python3-numpy        # Python readers and checks of the output
   python3-matplotlib                # galleries, histograms and plots in the README
