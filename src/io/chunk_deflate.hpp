@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace hypershape::io {
@@ -15,9 +16,13 @@ namespace hypershape::io {
 /// The DEFLATE level of every shard array (the dataset's declared filter says the same).
 inline constexpr int kDeflateLevel = 4;
 
-/// Writes the whole of `data` (row-major, `dims`) into the chunked dataset `ds`, whose creation
-/// list set `chunk` (equal to `dims` past the first axis), H5Pset_shuffle and then
-/// H5Pset_deflate(kDeflateLevel); `elem` is the bytes of one element.
+/// Declares on the dataset creation list `dcpl` what write_deflated_chunks applies: chunks of
+/// `chunk` (equal to the dataset's dims past the first axis), the shuffle, then deflate at
+/// kDeflateLevel. `what` names the dataset in an error.
+void declare_deflated_chunks(hid_t dcpl, const std::vector<hsize_t>& chunk, const std::string& what);
+
+/// Writes the whole of `data` (row-major, `dims`) into the chunked dataset `ds`, created with
+/// declare_deflated_chunks(`chunk`); `elem` is the bytes of one element.
 void write_deflated_chunks(hid_t ds, const void* data, const std::vector<hsize_t>& dims,
                            const std::vector<hsize_t>& chunk, std::size_t elem);
 

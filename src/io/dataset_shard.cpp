@@ -59,9 +59,7 @@ void write_array(hid_t g, const Array& a) {
       const hsize_t rest = rank > 1 ? n / dims[0] : 1;
       chunk[0] = std::clamp<hsize_t>((1u << 20) / std::max<hsize_t>(1, rest * elem / 4), 1, dims[0]);
     }
-    check(H5Pset_chunk(dcpl.id, rank, chunk.data()), a.name);
-    check(H5Pset_shuffle(dcpl.id), a.name);
-    check(H5Pset_deflate(dcpl.id, kDeflateLevel), a.name);
+    declare_deflated_chunks(dcpl.id, chunk, a.name);
   }
   Id lcpl{check_id(H5Pcreate(H5P_LINK_CREATE), a.name), H5Pclose};
   check(H5Pset_create_intermediate_group(lcpl.id, 1), a.name);

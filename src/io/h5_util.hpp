@@ -44,9 +44,7 @@ inline void write_2d(hid_t parent, const char* name, hid_t type, const void* dat
   Id space{check_id(H5Screate_simple(2, dims.data(), nullptr), name), H5Sclose};
   Id plist = untimed(H5P_DATASET_CREATE);
   if (rows > 0) {
-    check(H5Pset_chunk(plist.id, 2, chunk.data()), name);
-    check(H5Pset_shuffle(plist.id), name);
-    check(H5Pset_deflate(plist.id, kDeflateLevel), name);
+    declare_deflated_chunks(plist.id, chunk, name);
   }
   Id ds{check_id(H5Dcreate2(parent, name, type, space.id, H5P_DEFAULT, plist.id, H5P_DEFAULT), name), H5Dclose};
   if (rows > 0) write_deflated_chunks(ds.id, data, dims, chunk, H5Tget_size(type));
