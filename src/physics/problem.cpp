@@ -239,10 +239,24 @@ void Problem::subtract_loads(double load_factor, Vec r) const {
   if (fixed_load_) HS_PETSC(VecAXPY(r, -1.0, fixed_load_));
 }
 
+void Problem::zero_tangent(Mat J) const {
+  // Under a CellSubset (a local solve's patch) on one rank, only the entries its cells add to:
+  // a patch's tangent is read at the dofs whose cells all lie in it, and zeroing all of J for
+  // each of its steps was two thirds of the memset time of a Random2D P2 run (callgrind).
+  if (space_->restricted()) {
+    const CellMatrixAdder adder(*space_, J);
+    if (adder.direct()) {
+      for (const PetscInt c : space_->cells()) adder.zero(c);
+      return;
+    }
+  }
+  HS_PETSC(MatZeroEntries(J));
+}
+
 bool Problem::jacobian(Vec u, Mat J, double load_factor) const {
   LocalArray ul(dm(), false);
   to_local(u, ul.vec());
-  HS_PETSC(MatZeroEntries(J));
+  zero_tangent(J);
   bool ok = true;
   for (auto& eff : effects_) {
     if (eff->has_energy()) ok = ok && eff->add_jacobian(*space_, ul.array(), J);

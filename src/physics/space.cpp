@@ -592,6 +592,13 @@ CellMatrixAdder::CellMatrixAdder(const Space& space, Mat J) : space_(space), J_(
   HS_PETSC(MatSeqAIJGetArray(J, &values_));
 }
 
+void CellMatrixAdder::zero(PetscInt c) const {
+  const std::size_t nn = std::size_t(n_) * std::size_t(n_);
+  const PetscInt* off = offsets_ + std::size_t(c - space_.c0_) * nn;
+  for (std::size_t k = 0; k < nn; ++k)
+    if (off[k] >= 0) values_[off[k]] = 0.0;
+}
+
 CellMatrixAdder::~CellMatrixAdder() {
   if (values_) MatSeqAIJRestoreArray(J_, &values_);  // no throw from a destructor
 }

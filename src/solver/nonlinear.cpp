@@ -89,7 +89,8 @@ void NonlinearSolver::reset() {
 PetscErrorCode NonlinearSolver::form_function(SNES snes, Vec x, Vec f, void* ctx) {
   auto* self = static_cast<NonlinearSolver*>(ctx);
   return guarded([&] {
-    if (!self->problem_.residual(x, self->s_eval_, f)) HS_PETSC(SNESSetFunctionDomainError(snes));
+    // From the kept internal force where x is the state it belongs to (the final check of a path).
+    if (!self->residual_at(x, self->s_eval_, f)) HS_PETSC(SNESSetFunctionDomainError(snes));
   });
 }
 
@@ -148,9 +149,7 @@ double NonlinearSolver::backtrack(Vec X, Vec Y, Vec F, double s, Vec W, Vec G) {
     double e;
     trial_internal_ = NAN;
     if (!trial_force_) HS_PETSC(VecDuplicate(W, trial_force_.out()));
-    const bool admissible = problem_.conservative()
-                                ? problem_.energy_residual(W, s, e, G, &trial_internal_, trial_force_)
-                                : problem_.energy_along(X, W, s, e);
+    const bool admissible = problem_.conservative() ? evaluate_trial(W, s, e, G) : problem_.energy_along(X, W, s, e);
     if (!admissible) {  // inadmissible: never accept, halve
       lambda *= 0.5;
       continue;
@@ -191,6 +190,45 @@ double NonlinearSolver::energy_at_start(Vec X, double s) {
   double e;
   problem_.energy(X, s, e);
   return e;
+}
+
+bool NonlinearSolver::evaluate_known(Vec X, double s, Vec r) {
+  // The numbers of residual() and energy(): the energy and force of one loop are those of the
+  // two (unit.solver: the known state).
+  if (!trial_force_) HS_PETSC(VecDuplicate(X, trial_force_.out()));
+  double e;
+  trial_internal_ = NAN;
+  if (!problem_.energy_residual(X, s, e, r, &trial_internal_, trial_force_)) return false;
+  known_internal_ = trial_internal_;
+  if (!known_state_) HS_PETSC(VecDuplicate(X, known_state_.out()));
+  HS_PETSC(VecCopy(X, known_state_));
+  std::swap(known_force_, trial_force_);
+  return true;
+}
+
+bool NonlinearSolver::evaluate_ahead(Vec X, double s, Vec r) {
+  ahead_internal_ = NAN;
+  if (!problem_.conservative()) return problem_.residual(X, s, r);
+  if (!ahead_force_) HS_PETSC(VecDuplicate(X, ahead_force_.out()));
+  if (!ahead_state_) HS_PETSC(VecDuplicate(X, ahead_state_.out()));
+  double e, internal;
+  if (!problem_.energy_residual(X, s, e, r, &internal, ahead_force_)) return false;
+  HS_PETSC(VecCopy(X, ahead_state_));
+  ahead_internal_ = internal;
+  return true;
+}
+
+bool NonlinearSolver::evaluate_trial(Vec W, double s, double& e, Vec G) {
+  PetscBool same = PETSC_FALSE;
+  if (!std::isnan(ahead_internal_)) HS_PETSC(VecEqual(W, ahead_state_, &same));
+  if (!same) return problem_.energy_residual(W, s, e, G, &trial_internal_, trial_force_);
+  // The numbers energy_residual gives: the energy and force are the same pass's.
+  trial_internal_ = ahead_internal_;
+  ahead_internal_ = NAN;
+  std::swap(trial_force_, ahead_force_);
+  e = problem_.energy_from_internal(W, s, trial_internal_);
+  problem_.residual_from_internal(trial_force_, s, G);
+  return true;
 }
 
 bool NonlinearSolver::residual_at(Vec X, double s, Vec r) {

@@ -119,7 +119,8 @@ bool NonlinearSolver::relax_patch(PetscReal& rn) {
   if (!relaxation_) relaxation_ = std::make_unique<LocalRelaxation>(problem_);
   const LocalRelaxation::Result res = relaxation_->relax(u_, s_, r_, c_);
   if (!res.relaxed) return false;
-  if (!residual_at(u_, s_, r_)) throw std::logic_error("a relaxed state is inadmissible");
+  // With its energy and internal force kept: the corrector's line search starts from them.
+  if (!evaluate_known(u_, s_, r_)) throw std::logic_error("a relaxed state is inadmissible");
   HS_PETSC(VecNorm(r_, NORM_2, &rn));
   HS_PETSC(PetscInfo(snes_.get(), "local relaxation: %d dofs, |R| there %g -> %g in %d steps; |R| %g\n", res.dofs,
                      res.before, res.after, res.iterations, double(rn)));
@@ -356,8 +357,8 @@ bool NonlinearSolver::second_order_term(double dalpha, double ca, double& s_pred
 double NonlinearSolver::curvature_along_step(double s, double ds, Vec q) {
   if (!curvature_) HS_PETSC(VecDuplicate(u_, curvature_.out()));
   Vec k2 = curvature_;
-  HS_PETSC(VecWAXPY(w_, -1.0, du_, u_));  // u + v
-  if (!problem_.residual(w_, s + ds, q)) return -1;
+  HS_PETSC(VecWAXPY(w_, -1.0, du_, u_));  // u + v: the line search's first trial where the term is not taken
+  if (!evaluate_ahead(w_, s + ds, q)) return -1;
   HS_PETSC(VecWAXPY(w_, 1.0, du_, u_));  // u - v
   if (!problem_.residual(w_, s - ds, k2)) return -1;
   HS_PETSC(VecAXPBY(q, 0.5, 0.5, k2));

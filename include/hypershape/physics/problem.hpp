@@ -141,6 +141,8 @@ class Problem {
   void to_local(Vec u, Vec ul) const;
   /// The global residual from the local array of the cells' sums: minus the loads.
   void finish_residual(core::LocalArray& rl, double load_factor, Vec r, Vec internal_force = nullptr) const;
+  /// Zeroes J before an assembly: all of it, or under a CellSubset the entries its cells add to.
+  void zero_tangent(Mat J) const;
   /// r -= load_factor f_ext + f_fixed.
   void subtract_loads(double load_factor, Vec r) const;
   void assemble_load();

@@ -53,6 +53,8 @@ class CellMatrixAdder {
   CellMatrixAdder(const CellMatrixAdder&) = delete;
   CellMatrixAdder& operator=(const CellMatrixAdder&) = delete;
   void add(PetscInt c, const double* Ke) const;
+  /// Zeroes the entries cell c adds to (direct() only).
+  void zero(PetscInt c) const;
   /// Whether this adder writes into the CSR values directly.
   bool direct() const { return values_ != nullptr; }
 
@@ -88,6 +90,8 @@ class Space {
   /// The cells the assembly loops visit, in order: every local cell, or the subset a
   /// CellSubset has made active (a local solve's patch: src/solver/local_relaxation.cpp).
   std::span<const PetscInt> cells() const { return subset_ ? *subset_ : std::span<const PetscInt>(all_cells_); }
+  /// Whether a CellSubset is active.
+  bool restricted() const { return subset_ != nullptr; }
   std::int64_t n_cells_global() const { return n_cells_global_; }
   std::int64_t n_dofs_global() const { return n_dofs_global_; }  ///< unconstrained dofs
   std::int64_t n_vertices_global() const { return n_vertices_global_; }
@@ -188,7 +192,8 @@ class Space {
 
 /// While it lives, the assembly loops of `space` (Space::cells) visit only `cells` (sorted, local
 /// cell numbers): the energy, residual and tangent of a patch, exact at the dofs whose cells all
-/// lie in it. Not nested; not collective.
+/// lie in it (on one rank the tangent's other entries keep what they held: Problem::jacobian
+/// zeroes only the entries the patch's cells add to). Not nested; not collective.
 class CellSubset {
  public:
   CellSubset(const Space& space, const std::vector<PetscInt>& cells) : space_(space) { space_.subset_ = &cells; }

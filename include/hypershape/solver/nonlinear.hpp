@@ -305,6 +305,16 @@ class NonlinearSolver {
   bool residual_at(Vec X, double s, Vec r);
   /// Whether X is bit for bit the state accept_trial kept the stored energy and force of.
   bool is_known_state(Vec X);
+  /// R(X, s) into r with X's energy and internal force in one pass, kept as accept_trial keeps
+  /// a trial's (a conservative problem): X's next residual_at and energy_at_start cost no pass.
+  /// False where X is inadmissible.
+  bool evaluate_known(Vec X, double s, Vec r);
+  /// R(X, s) into r for a state the next line search may try first (u + v of the second-order
+  /// terms): with a conservative problem its energy and internal force are kept for it.
+  bool evaluate_ahead(Vec X, double s, Vec r);
+  /// backtrack's trial W at load s: its energy e and residual G, from evaluate_ahead's pass
+  /// where W is bit for bit that state. False where W is inadmissible.
+  bool evaluate_trial(Vec W, double s, double& e, Vec G);
   /// Newton's method on the SNES at load factor s from u_, converged when |R| <= atol + rtol (|s|
   /// |f_ext| + fixed_norm) (checked on the true residual; rtol <= 0: the options' rtol).
   bool newton(double s, SolveResult& r, double fixed_norm = 0, double rtol = 0);
@@ -489,6 +499,8 @@ class NonlinearSolver {
   /// NaN: none).
   double trial_internal_ = NAN, known_internal_ = NAN;
   core::VecH trial_force_, known_force_, known_state_;
+  double ahead_internal_ = NAN;  ///< evaluate_ahead's state (NaN: none): energy, force, the state
+  core::VecH ahead_force_, ahead_state_;
   core::VecH curvature_;  ///< second_order_term's K^-1 q (created at its first use)
   double step_hint_ = 0;
   double s0_ = 0;       ///< load factor of the state a branch switch left (in v0_)
