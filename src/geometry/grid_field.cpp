@@ -5,6 +5,11 @@
 #include <cassert>
 #include <cmath>
 #include <cstring>
+#include <deque>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <tuple>
 #include <type_traits>
 #include <vector>
 
@@ -144,6 +149,34 @@ Eigen::MatrixXd kernel_factor(int n, double spacing, double sigma) {
   return eig.eigenvectors() * root.asDiagonal();
 }
 
+/// kernel_factor(n, spacing, sigma), computed once per process for each (n, spacing, sigma): a
+/// shape's grids are of a few sizes (each deformation step works in the box [-1, 1]^d of the
+/// step before, so its longest axis has the same node count on every shape), and the
+/// eigendecomposition was a twentieth of a Random2D shape's work (callgrind). The same numbers:
+/// a factor is the same computation's result. At most kMaxBytes are kept (the oldest dropped).
+std::shared_ptr<const Eigen::MatrixXd> cached_kernel_factor(int n, double spacing, double sigma) {
+  using Key = std::tuple<int, double, double>;
+  static std::mutex mutex;
+  static std::map<Key, std::shared_ptr<const Eigen::MatrixXd>> cache;
+  static std::deque<Key> order;
+  static std::size_t bytes = 0;
+  constexpr std::size_t kMaxBytes = std::size_t(64) << 20;
+  const Key key{n, spacing, sigma};
+  std::lock_guard<std::mutex> lock(mutex);
+  if (const auto it = cache.find(key); it != cache.end()) return it->second;
+  auto a = std::make_shared<const Eigen::MatrixXd>(kernel_factor(n, spacing, sigma));
+  const std::size_t size = std::size_t(n) * std::size_t(n) * sizeof(double);
+  while (!order.empty() && bytes + size > kMaxBytes) {
+    bytes -= std::size_t(cache[order.front()]->size()) * sizeof(double);
+    cache.erase(order.front());
+    order.pop_front();
+  }
+  cache.emplace(key, a);
+  order.push_back(key);
+  bytes += size;
+  return a;
+}
+
 }  // namespace
 
 void GridField::evaluate(const double* x, double* value) const { evaluate(1, x, value); }
@@ -168,10 +201,11 @@ GridField sample_velocity_field(const Grid& grid, double sigma, double m,
   assert(sigma > 0.0);
   GridField field(grid);
   const int n0 = grid.n[0], n1 = grid.n[1], n2 = grid.n[2];
-  const Eigen::MatrixXd a0 = kernel_factor(n0, grid.spacing, sigma);
-  const Eigen::MatrixXd a1 = kernel_factor(n1, grid.spacing, sigma);
-  const Eigen::MatrixXd a2 = grid.dim == 3 ? kernel_factor(n2, grid.spacing, sigma)
-                                           : Eigen::MatrixXd::Identity(1, 1);
+  const auto f0 = cached_kernel_factor(n0, grid.spacing, sigma);
+  const auto f1 = cached_kernel_factor(n1, grid.spacing, sigma);
+  const auto f2 = grid.dim == 3 ? cached_kernel_factor(n2, grid.spacing, sigma)
+                                : std::make_shared<const Eigen::MatrixXd>(Eigen::MatrixXd::Identity(1, 1));
+  const Eigen::MatrixXd &a0 = *f0, &a1 = *f1, &a2 = *f2;
   using Map = Eigen::Map<Eigen::MatrixXd>;
   const std::int64_t n = grid.n_nodes();
   std::vector<double> v(static_cast<std::size_t>(n));  // one component, node by node
