@@ -83,7 +83,12 @@ NonlinearSolver::NonlinearSolver(const physics::Problem& problem, const SolverOp
 void NonlinearSolver::reset() {
   HS_PETSC(VecZeroEntries(u_));
   s_ = 0;
+  forget_evaluations();
+}
+
+void NonlinearSolver::forget_evaluations() {
   known_internal_ = NAN;
+  ahead_internal_ = NAN;
 }
 
 PetscErrorCode NonlinearSolver::form_function(SNES snes, Vec x, Vec f, void* ctx) {
@@ -284,7 +289,7 @@ TargetResult NonlinearSolver::solve_for_target_from(Vec u, double load_factor, d
 }
 
 TargetResult NonlinearSolver::attempt_target(double target, double start) {
-  known_internal_ = NAN;  // the problem may have changed since (effects switched, a new load)
+  forget_evaluations();  // the problem may have changed since (effects switched, a new load)
   TargetResult t = opt_.control == Control::displacement ? follow_path(target, start)
                                                           : search_target(target, start);
   // (t.solves == 0: the path never started, e.g. no tangent at the initial state: no branch.)

@@ -305,6 +305,8 @@ class NonlinearSolver {
   bool residual_at(Vec X, double s, Vec r);
   /// Whether X is bit for bit the state accept_trial kept the stored energy and force of.
   bool is_known_state(Vec X);
+  /// Drops the kept energies and forces (known and ahead): the problem may have changed.
+  void forget_evaluations();
   /// R(X, s) into r with X's energy and internal force in one pass, kept as accept_trial keeps
   /// a trial's (a conservative problem): X's next residual_at and energy_at_start cost no pass.
   /// False where X is inadmissible.
