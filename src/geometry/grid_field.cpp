@@ -167,7 +167,7 @@ std::shared_ptr<const Eigen::MatrixXd> cached_kernel_factor(int n, double spacin
   auto a = std::make_shared<const Eigen::MatrixXd>(kernel_factor(n, spacing, sigma));
   const std::size_t size = std::size_t(n) * std::size_t(n) * sizeof(double);
   while (!order.empty() && bytes + size > kMaxBytes) {
-    bytes -= std::size_t(cache[order.front()]->size()) * sizeof(double);
+    bytes -= std::size_t(cache.at(order.front())->size()) * sizeof(double);
     cache.erase(order.front());
     order.pop_front();
   }

@@ -177,11 +177,15 @@ double NonlinearSolver::backtrack(Vec X, Vec Y, Vec F, double s, Vec W, Vec G) {
 
 void NonlinearSolver::accept_trial(Vec W, Vec X) {
   HS_PETSC(VecCopy(W, X));
+  keep_trial_as(X);
+}
+
+void NonlinearSolver::keep_trial_as(Vec X) {
   known_internal_ = trial_internal_;
   if (std::isnan(known_internal_)) return;
   if (!known_state_) HS_PETSC(VecDuplicate(X, known_state_.out()));
   HS_PETSC(VecCopy(X, known_state_));
-  std::swap(known_force_, trial_force_);  // trial_force_ holds W's (the trial evaluated last)
+  std::swap(known_force_, trial_force_);  // trial_force_ holds X's (the trial evaluated last)
 }
 
 bool NonlinearSolver::is_known_state(Vec X) {
@@ -198,16 +202,13 @@ double NonlinearSolver::energy_at_start(Vec X, double s) {
 }
 
 bool NonlinearSolver::evaluate_known(Vec X, double s, Vec r) {
-  // The numbers of residual() and energy(): the energy and force of one loop are those of the
-  // two (unit.solver: the known state).
+  // The numbers of residual() and energy(): one pass gives both bit for bit (unit.physics.assembly,
+  // "Energy and residual in one pass equal the two passes bit for bit").
   if (!trial_force_) HS_PETSC(VecDuplicate(X, trial_force_.out()));
   double e;
   trial_internal_ = NAN;
   if (!problem_.energy_residual(X, s, e, r, &trial_internal_, trial_force_)) return false;
-  known_internal_ = trial_internal_;
-  if (!known_state_) HS_PETSC(VecDuplicate(X, known_state_.out()));
-  HS_PETSC(VecCopy(X, known_state_));
-  std::swap(known_force_, trial_force_);
+  keep_trial_as(X);
   return true;
 }
 

@@ -298,6 +298,8 @@ class NonlinearSolver {
   /// X = W, the trial backtrack accepted last: its stored energy is kept for X's next line
   /// search (its energy at lambda = 0 without a pass over the cells).
   void accept_trial(Vec W, Vec X);
+  /// Keeps the trial evaluated last (its energy and internal force) as X's.
+  void keep_trial_as(Vec X);
   /// The energy of X at load s: from the stored energy accept_trial kept if X is unchanged since.
   double energy_at_start(Vec X, double s);
   /// R(X, s) into r, from the internal force accept_trial kept if X is unchanged since. False
