@@ -49,7 +49,8 @@ struct NeoHookean {
     return true;
   }
 
-  bool stress_tangent(const Tensor<D>& F, Tensor<D>& P, Tangent<D>& A) const {
+  // Inlined into the cell loops, where the tangent assembly drops the P it does not read.
+  [[gnu::always_inline]] bool stress_tangent(const Tensor<D>& F, Tensor<D>& P, Tangent<D>& A) const {
     const double J = F.determinant();
     if (!(J > 0)) return false;
     const Tensor<D> Fi = F.inverse();
