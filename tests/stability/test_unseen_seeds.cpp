@@ -204,6 +204,44 @@ TEST_CASE("Replay one shape's load cases as the factory does", "[.][unseen_repla
   replay(c, ns, env_int("FROM", 0), load);
 }
 
+TEST_CASE("A hinted path that fails on any platform is solved again from rest as alone", "[stability][branch]") {
+  // The case above exercises retry_from_rest only where OpenBLAS's kernels lose its hinted path
+  // (SkylakeX, with the solver of 2026-11-28); on Haswell / Zen and Cooperlake kernels, and with
+  // today's solver, the hinted path reaches its target there. Here the hint itself fails the
+  // first try wherever it runs: 1e-5 of the target as the first increment makes the path dozens of
+  // increments long, beyond a Newton budget of 20, while from rest load 48 (target 0.17) takes a few.
+  Case c(777, 3);
+  const auto& lc = c.set(48);
+  solver::SolverOptions opt = c.cfg.solver;
+  opt.newton_budget = 20;
+  opt.fallback = false;
+  auto hinted = [&](solver::NonlinearSolver& ns) {
+    ns.set_step_hint(1e-5 * lc.target);
+    return ns.solve_for_target(lc.target);
+  };
+  solver::SolverOptions no_retry = opt;
+  no_retry.retry_from_rest = false;
+  solver::NonlinearSolver lost_ns(*c.sp.problem, no_retry), ns(*c.sp.problem, opt), alone(*c.sp.problem, opt);
+  const auto lost = hinted(lost_ns);
+  INFO("without the retry: " << lost.reason);
+  REQUIRE_FALSE(lost.converged);
+  CHECK(lost.reason.find("Newton budget") != std::string::npos);
+  const auto r = hinted(ns);
+  INFO("with it: " << r.reason);
+  REQUIRE(r.converged);
+  CHECK(r.reason.rfind("target reached from rest without the first-increment hint (first try: ", 0) == 0);
+  CHECK(r.recovery_iterations >= lost.newton_iterations);  // the failed try counts, as recovery
+  hstest::check_stable_on_target(*c.sp.problem, ns.solution(), r, lc.target, opt);
+  // The retry is the solve from rest a fresh solver makes: the same equilibrium, bit for bit.
+  const auto fresh = alone.solve_for_target(lc.target);
+  REQUIRE(fresh.converged);
+  CHECK(r.alpha == fresh.alpha);
+  CHECK(r.newton_iterations == lost.newton_iterations + fresh.newton_iterations);
+  PetscBool same;
+  HS_PETSC(VecEqual(ns.solution(), alone.solution(), &same));
+  CHECK(same);
+}
+
 TEST_CASE("A load case lost on the hinted path is solved again from rest; the next one is unchanged",
           "[stability][branch]") {
   // Seed 777, shape 3, load 47 in the factory's order (from load 0, each path's first increment
