@@ -92,6 +92,7 @@ def plot(data, path):
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import matplotlib.ticker
 
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), sharey=True)
     for family, colour in zip(sorted(data), ("C0", "C1", "C2", "C3")):
@@ -110,6 +111,9 @@ def plot(data, path):
     axes[0].set_ylabel("true relative L2 error of u, % (median, p10-p90)")
     for ax in axes:
         ax.set_yscale("log")
+        ax.set_yticks([0.2, 0.3, 0.5, 1, 2, 3, 5])
+        ax.yaxis.set_major_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
+        ax.yaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
         ax.grid(True, which="both", alpha=0.3)
     axes[0].legend(fontsize=8)
     fig.suptitle("2D presets at P2: the mesh at the Dirichlet patch ends (as drawn, graded) against the PDE's solution")
