@@ -205,11 +205,12 @@ TEST_CASE("Replay one shape's load cases as the factory does", "[.][unseen_repla
 }
 
 TEST_CASE("A hinted path that fails on any platform is solved again from rest as alone", "[stability][branch]") {
-  // The case above exercises retry_from_rest only where OpenBLAS's kernels lose its hinted path
+  // The case below exercises retry_from_rest only where OpenBLAS's kernels lose its hinted path
   // (SkylakeX, with the solver of 2026-11-28); on Haswell / Zen and Cooperlake kernels, and with
   // today's solver, the hinted path reaches its target there. Here the hint itself fails the
-  // first try wherever it runs: 1e-5 of the target as the first increment makes the path dozens of
-  // increments long, beyond a Newton budget of 20, while from rest load 48 (target 0.17) takes a few.
+  // first try wherever it runs: 1e-5 of the target as the first increment, growing 1.5x per easy
+  // increment, makes the path about 30 increments long, beyond a Newton budget of 20, while from
+  // rest load 48 (target 0.17) takes a few.
   Case c(777, 3);
   const auto& lc = c.set(48);
   solver::SolverOptions opt = c.cfg.solver;
