@@ -14,6 +14,7 @@ the same target: median, p10, p90, max; alpha's median; unknowns; Newton iterati
 case) and draws the true error against the unknowns and against the Newton iterations, the
 costs that do not depend on the host's load (the study's seconds do: it ran beside other jobs)."""
 import argparse
+import functools
 import json
 import os
 import re
@@ -25,49 +26,63 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 LABEL = re.compile(r"^(?P<family>[a-z0-9_]+)-P(?P<degree>\d)-h(?P<h>[0-9.]+)(?:-graded(?P<g>[0-9.]+))?$")
 
 
+@functools.lru_cache(maxsize=None)
 def preset_grading(family):
     """The preset's own patch-end size over h (mesh.rim / shapes.h), 0 where it has no rim."""
     import yaml  # python3-yaml, only where a file holds the preset as it is
 
-    cfg = yaml.safe_load(open(os.path.join(HERE, "..", "configs", "presets", f"{family}.yaml")))
-    rim = (cfg.get("mesh") or {}).get("rim", 0.0)
-    return float(rim) / float(cfg["shapes"]["h"])
+    path = os.path.join(HERE, "..", "configs", "presets", f"{family}.yaml")
+    try:
+        cfg = yaml.safe_load(open(path))
+        rim = (cfg.get("mesh") or {}).get("rim", 0.0)
+        return float(rim) / float(cfg["shapes"]["h"])
+    except (OSError, KeyError, TypeError, ValueError, yaml.YAMLError) as e:
+        raise SystemExit(f"{path}: no preset '{family}' with shapes.h to read its grading from ({e})")
 
 
 def load(files):
     """{family: {grading: {(shape, load): row}}} of the converged load cases with a true error."""
     out = {}
     for f in files:
-        for line in open(f):
+        try:
+            lines = open(f).read().splitlines()
+        except OSError as e:
+            raise SystemExit(f"{f}: cannot read ({e.strerror})")
+        for n, line in enumerate(lines, 1):
             if not line.strip():
                 continue
-            r = json.loads(line)
-            m = LABEL.match(r["case"])
+            try:
+                r = json.loads(line)
+                case, shape, load_id = r["case"], r["shape"], r["load"]
+            except (ValueError, KeyError, TypeError) as e:
+                raise SystemExit(f"{f}:{n}: not a study line with case, shape and load ({e})")
+            m = LABEL.match(case)
             if not m:
-                raise SystemExit(f"{f}: case label {r['case']!r} is not FAMILY-P<degree>-h<h>[-graded<G>]")
+                raise SystemExit(f"{f}: case label {case!r} is not FAMILY-P<degree>-h<h>[-graded<G>]")
             g = float(m["g"]) if m["g"] is not None else preset_grading(m["family"])
             if r.get("converged") and r.get("true_rel_l2") is not None:
-                out.setdefault(m["family"], {}).setdefault(g, {})[(r["shape"], r["load"])] = r
+                out.setdefault(m["family"], {}).setdefault(g, {})[(shape, load_id)] = r
     return out
 
 
 def summarise(settings):
-    """Per grading (as drawn first, then ever finer ends), the statistics over the common cases."""
-    common = set.intersection(*(set(cases) for cases in settings.values()))
+    """Per grading (as drawn first, then ever finer ends), the statistics over the cases every
+    setting has (main refuses a family without one)."""
+    common = sorted(set.intersection(*(set(cases) for cases in settings.values())))
     rows = []
     for g in sorted(settings, key=lambda g: (g != 0, -g)):
-        cases = [settings[g][k] for k in sorted(common)]
+        cases = [settings[g][k] for k in common]
         err = np.array([c["true_rel_l2"] for c in cases])
         rows.append({
             "grading": g,
             "n": len(cases),
-            "median": float(np.median(err)) if len(err) else float("nan"),
-            "p10": float(np.percentile(err, 10)) if len(err) else float("nan"),
-            "p90": float(np.percentile(err, 90)) if len(err) else float("nan"),
-            "max": float(err.max()) if len(err) else float("nan"),
-            "alpha": float(np.median([abs(c["true_alpha"]) for c in cases])) if len(err) else float("nan"),
-            "dofs": float(np.median([c["n_dofs"] for c in cases])) if len(err) else float("nan"),
-            "newton": float(np.mean([c["newton_iterations"] for c in cases])) if len(err) else float("nan"),
+            "median": float(np.median(err)),
+            "p10": float(np.percentile(err, 10)),
+            "p90": float(np.percentile(err, 90)),
+            "max": float(err.max()),
+            "alpha": float(np.median([abs(c["true_alpha"]) for c in cases])),
+            "dofs": float(np.median([c["n_dofs"] for c in cases])),
+            "newton": float(np.mean([c["newton_iterations"] for c in cases])),
         })
     return rows
 
@@ -127,6 +142,9 @@ def main(argv):
     ap.add_argument("--out", help="PNG to write (none: the table only)")
     a = ap.parse_args(argv)
     data = load(a.files)
+    if not data:
+        print("no converged load case with a true error in " + ", ".join(a.files), file=sys.stderr)
+        return 1
     for family, settings in data.items():
         if len(settings) < 2:
             print(f"{family}: one setting only ({setting_name(next(iter(settings)))}): nothing to compare", file=sys.stderr)

@@ -4,8 +4,9 @@
     quotes (random2d 1.30% as drawn, 0.98% at h/16, 0.67% at h/32, the preset; easy_random2d
     1.68% -> 0.69% -> 0.40%; one_random2d 1.21% -> 0.39%), each on the same load cases;
   - a preset file without a grading in its label takes the preset's own mesh.rim / shapes.h;
-  - a family with a single setting, or a label it cannot read, stops it with exit code 1 and a
-    message, writing no file.
+  - a family with a single setting, a label it cannot read, a missing file, a line that is not
+    JSON or a preset that does not exist stops it with exit code 1 and a message naming it
+    (no traceback), writing no file.
 Needs HYPERSHAPE_SOURCE_DIR (set by CTest)."""
 import glob
 import json
@@ -48,4 +49,20 @@ with tempfile.TemporaryDirectory() as tmp:
     r = subprocess.run([sys.executable, script, "--out", png2, bad], capture_output=True, text=True)
     check(r.returncode == 1 and "bad.jsonl" in r.stderr and "disk P2" in r.stderr and not os.path.exists(png2),
           f"an unreadable label: exit {r.returncode}, {r.stderr.strip()}")
+    missing = os.path.join(tmp, "missing.jsonl")
+    r = subprocess.run([sys.executable, script, "--out", png2, missing], capture_output=True, text=True)
+    check(r.returncode == 1 and "missing.jsonl" in r.stderr and "Traceback" not in r.stderr and not os.path.exists(png2),
+          f"a file that is not there: exit {r.returncode}, {r.stderr.strip()}")
+    garbled = os.path.join(tmp, "garbled.jsonl")
+    with open(garbled, "w") as f:
+        f.write('{"case": "random2d-P2-h0.12", "shape"\n')
+    r = subprocess.run([sys.executable, script, "--out", png2, garbled], capture_output=True, text=True)
+    check(r.returncode == 1 and "garbled.jsonl:1" in r.stderr and "Traceback" not in r.stderr and not os.path.exists(png2),
+          f"a line that is not JSON: exit {r.returncode}, {r.stderr.strip()}")
+    unknown = os.path.join(tmp, "unknown.jsonl")
+    with open(unknown, "w") as f:
+        f.write(json.dumps({"case": "nosuch2d-P2-h0.12", "shape": 0, "load": 0, "converged": True, "true_rel_l2": 0.01}) + "\n")
+    r = subprocess.run([sys.executable, script, "--out", png2, unknown], capture_output=True, text=True)
+    check(r.returncode == 1 and "nosuch2d" in r.stderr and "Traceback" not in r.stderr and not os.path.exists(png2),
+          f"a preset that does not exist: exit {r.returncode}, {r.stderr.strip()}")
 sys.exit(1 if checks.failures else 0)
