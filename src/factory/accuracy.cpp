@@ -38,6 +38,12 @@ int next_accuracy_level(const config::DatasetConfig& cfg, int current, double wo
   return std::max(current + 1, last);
 }
 
+bool curable(const config::DatasetConfig& cfg, int current, double rel_l2) {
+  const int last = cfg.accuracy.max_level;
+  if (rel_l2 < 0 || current >= last) return rel_l2 < 0 && current < last;
+  return rel_l2 / predicted_reduction(accuracy_level(cfg, current), accuracy_level(cfg, last)) <= cfg.accuracy.rel_l2;
+}
+
 namespace {
 
 /// The fine vertex at the midpoint of each coarse edge (a < b), read from the children's

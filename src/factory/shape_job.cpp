@@ -544,17 +544,23 @@ io::ShapeRecord solved_record(const ShapeSample& shape) {
   return r;
 }
 
-/// The largest estimate of the converged load cases (-1 when none was formed) and how many
-/// converged load cases miss the bound.
-std::pair<double, std::int64_t> worst_estimate(const config::AccuracyConfig& a, const ShapeSolve& s) {
-  double worst = -1;
-  std::int64_t n_exceeding = 0;
+/// Over the converged load cases at `level`: the largest estimate (-1 when none was formed), the
+/// largest that a higher level is predicted to bring under the bound (curable(); -1: none), and
+/// how many miss the bound.
+struct Worst {
+  double estimate = -1, curable = -1;
+  std::int64_t exceeding = 0;
+};
+Worst worst_estimate(const config::DatasetConfig& cfg, int level, const ShapeSolve& s) {
+  Worst w;
   for (std::size_t k = 0; k < s.status.size() && k < s.rel_l2.size(); ++k) {
     if (!s.status[k]) continue;
-    worst = std::max(worst, s.rel_l2[k]);
-    n_exceeding += exceeds(a, s.rel_l2[k]);
+    w.estimate = std::max(w.estimate, s.rel_l2[k]);
+    if (!exceeds(cfg.accuracy, s.rel_l2[k])) continue;
+    w.exceeding += 1;
+    if (curable(cfg, level, s.rel_l2[k])) w.curable = std::max(w.curable, s.rel_l2[k]);
   }
-  return {worst, n_exceeding};
+  return w;
 }
 
 /// The accuracy ladder (factory/accuracy.hpp) on one drawn shape: levels are solved until one
@@ -566,14 +572,15 @@ void solve_by_accuracy(MPI_Comm group, const config::DatasetConfig& cfg, const S
                        ShapeJobResult& out) {
   const auto& acc = cfg.accuracy;
   const auto allowed = std::int64_t(std::floor(acc.exceed_share * double(cfg.loads.count) + 1e-9));
+  int level = 0;
   const StopRule miss = [&](const std::vector<std::int8_t>& status, const std::vector<double>& est, std::size_t L) {
     std::int64_t n = 0;
-    for (std::size_t k = 0; k <= L; ++k) n += status[k] && exceeds(acc, est[k]);
+    for (std::size_t k = 0; k <= L; ++k) n += status[k] && exceeds(acc, est[k]) && curable(cfg, level, est[k]);
     return n > allowed;
   };
   ShapeSample shape = drawn;
   int refinements = 0;
-  for (int level = 0;;) {
+  for (;;) {
     const AccuracyLevel a = accuracy_level(cfg, level);
     for (; refinements < a.refinements; ++refinements) shape = refine_shape(shape);
     config::DatasetConfig at = cfg;
@@ -585,7 +592,8 @@ void solve_by_accuracy(MPI_Comm group, const config::DatasetConfig& cfg, const S
     const ShapeSolve s = solve_shape(group, at, shape, cases, last ? StopRule{} : miss,
                                      [&](bool ok) { oks.push_back(ok); }, attempt);
     for (const auto& [name, sec] : attempt.times.all()) out.times.add(name, sec);
-    const auto [worst, n_exceeding] = worst_estimate(acc, s);
+    const Worst worst = worst_estimate(cfg, level, s);
+    const std::int64_t n_exceeding = worst.exceeding;
     if (!s.stopped) {  // kept: this level is the shape's
       const core::PhaseTimes times = out.times;
       SolveCounters spent = out.counters;
@@ -601,7 +609,7 @@ void solve_by_accuracy(MPI_Comm group, const config::DatasetConfig& cfg, const S
       numbers["accuracy_level"] = level;
       numbers["accuracy_degree"] = a.degree;
       numbers["accuracy_h"] = a.h;
-      numbers["accuracy_estimate_max"] = worst;
+      numbers["accuracy_estimate_max"] = worst.estimate;
       numbers["accuracy_exceeding"] = double(n_exceeding);
       numbers["accuracy_discarded_load_cases"] = double(out.accuracy.discarded_loads);
       if (on_load)
@@ -614,7 +622,7 @@ void solve_by_accuracy(MPI_Comm group, const config::DatasetConfig& cfg, const S
     out.accuracy.discarded_factorizations += attempt.counters.linear.numeric_factorizations;
     attempt.counters.loads_ok = attempt.counters.loads_failed = 0;
     out.counters += attempt.counters;
-    level = next_accuracy_level(cfg, level, worst);
+    level = next_accuracy_level(cfg, level, worst.curable);
   }
 }
 

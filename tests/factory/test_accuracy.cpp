@@ -109,6 +109,22 @@ TEST_CASE("The accuracy ladder and its prediction", "[factory][accuracy]") {
   CHECK(factory::accuracy_level(c, 1).refinements == 1);
 }
 
+TEST_CASE("A label no level is predicted to bring under the bound does not move its shape", "[factory][accuracy]") {
+  // P1 ladder to level 3 (P2, two refinements): the last level is predicted 40x below level 0,
+  // 4x below level 1, 2x below level 2.
+  const auto c = config::parse_dataset_text(head + "accuracy: {rel_l2: 0.01, max_level: 3}\n", "<test>");
+  CHECK(factory::curable(c, 0, 0.39));      // 0.39 / 40 meets 0.01
+  CHECK_FALSE(factory::curable(c, 0, 0.41));
+  CHECK(factory::curable(c, 1, 0.04));      // / 4
+  CHECK_FALSE(factory::curable(c, 1, 0.05));
+  CHECK(factory::curable(c, 2, 0.02));      // / 2
+  CHECK_FALSE(factory::curable(c, 2, 0.021));
+  CHECK(factory::curable(c, 0, -1));        // no estimate: worth a level up
+  CHECK(factory::curable(c, 2, -2));
+  CHECK_FALSE(factory::curable(c, 3, -1));  // nothing above the last level
+  CHECK_FALSE(factory::curable(c, 3, 0.011));
+}
+
 TEST_CASE("grade_shape keeps the polygon and its patch and grades the mesh towards the clamp ends",
           "[factory][accuracy]") {
   const auto c = config::parse_dataset_text(head, "<test>");
