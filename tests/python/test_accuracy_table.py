@@ -6,7 +6,9 @@
     seconds per load case and their ratio from the times log;
   - --json keeps every estimate, and --from-json gives the same table again and a figure;
   - a directory that is not a dataset, a dataset without estimates and a JSON file it did not
-    write stop it with exit code 1 and a message naming them (no traceback), writing no file.
+    write stop it with exit code 1 and a message naming them (no traceback), writing no file;
+  - the shipped study (docs/accuracy_levels/easy_random2d_4242.json) gives the shares
+    docs/ACCURACY.md quotes ("What each bound costs").
 Needs HYPERSHAPE_BIN and HYPERSHAPE_SOURCE_DIR (set by CTest)."""
 import glob
 import json
@@ -110,5 +112,17 @@ with tempfile.TemporaryDirectory() as tmp:
     r = run(plain, "--times", os.path.join(tmp, "none.log"))
     check(r.returncode == 1 and "none.log" in r.stderr and "Traceback" not in r.stderr,
           f"a times log that is not there: exit {r.returncode}, {r.stderr.strip()}")
+
+# The study docs/ACCURACY.md quotes ("What each bound costs"), drawn again from its JSON.
+shipped = os.path.join(src, "docs", "accuracy_levels", "easy_random2d_4242.json")
+r = run("--from-json", shipped)
+rows = {x["name"]: x for x in json.load(open(shipped))["runs"]}
+quoted = {"rel_l2_0.05": "196/200 | 96.4%", "rel_l2_0.03": "196/200 | 94.4%", "rel_l2_0.01": "196/200 | 92.3%"}
+check(r.returncode == 0 and all(f"| {k} | {k[7:]} | {v} |" in r.stdout for k, v in quoted.items()),
+      f"the shipped study's rows are the ones docs/ACCURACY.md quotes: {r.stdout.splitlines()[2:]}")
+first = np.array(rows["preset"]["estimates"])
+shares = [round(100 * np.mean(first <= b), 1) for b in (0.05, 0.03, 0.01)]
+check(rows["preset"]["converged"] == 199 and shares == [97.0, 96.0, 64.3],
+      f"the preset meets 0.05 / 0.03 / 0.01 on {shares}% of its 199 labels, as quoted")
 
 sys.exit(1 if checks.failures else 0)

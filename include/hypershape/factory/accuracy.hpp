@@ -16,9 +16,9 @@
 /// level is predicted to meet it (curable()), or have no estimate; the next level is the lowest
 /// whose predicted estimate, the worst curable one seen divided by predicted_reduction(), meets
 /// B. A load case that not even the last level is predicted to bring under B is counted above B
-/// and does not move its shape: measured (2026-12-01, EasyRandom2D at B = 0.05), such labels
-/// sit near a limit point of the load and their estimates do not fall with refinement, and
-/// climbing for them cost 100x the level-0 run for a lower share under B (docs/ACCURACY.md,
+/// and does not move its shape: measured (2026-12-01, EasyRandom2D at B = 0.05), the finer
+/// levels lost or flagged as many labels as they cured, and climbing for such labels made the
+/// run 101x the level-0 run's CPU for a lower share under B than level 0's own (docs/ACCURACY.md,
 /// "What each bound costs"). The last level (accuracy.max_level) is kept whatever its
 /// estimates, its load cases above B counted as such. Every choice is a function of the
 /// estimates, which are functions of the data: 1 rank and 2 ranks choose the same levels.
