@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
-# What each accuracy level costs (issue 19, docs/ACCURACY.md "What each accuracy level costs"):
+# What each accuracy bound costs (issue 19, docs/ACCURACY.md "What each bound costs"):
 # one preset on one seed generated as it is (with its labels' estimates) and then asked for by
 # accuracy (`accuracy: {rel_l2: B}`) at each bound B; per run the run report, the shards and the
 # process's CPU seconds, then scripts/accuracy_table.py (table, JSON and the figure).
 #   scripts/study_accuracy_levels.sh [PRESET] [SEED] [SHAPES] [LOADS]
-#     defaults: easy_random2d 4242 8 25; BOUNDS="0.05 0.03 0.02 0.01" (the bounds, any order);
+#     defaults: easy_random2d 4242 8 25; BOUNDS="0.05 0.03 0.01" (the bounds, any order);
 #     NP=2 (ranks); OUT=results/accuracy_levels/PRESET_SEED (the datasets, times.log, the table);
 #     JSON=docs/accuracy_levels/PRESET_SEED.json and PNG=docs/figures/accuracy_levels_PRESET.png
 #     (where the table's rows and its figure go); HYPERSHAPE=build/hypershape.
@@ -13,7 +13,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 preset=${1:-easy_random2d} seed=${2:-4242} shapes=${3:-8} loads=${4:-25}
-bounds=${BOUNDS:-0.05 0.03 0.02 0.01}
+bounds=${BOUNDS:-0.05 0.03 0.01}
 np=${NP:-2}
 bin=${HYPERSHAPE:-build/hypershape}
 out=${OUT:-results/accuracy_levels/${preset}_$seed}
