@@ -182,11 +182,15 @@ def main():
         print(f"accuracy_table.py: {e}", file=sys.stderr)
         return 1
     print(table(rows))
-    if a.json:
-        with open(a.json, "w") as f:
-            json.dump({"runs": rows}, f, indent=1)
-    if a.plot:
-        plot(rows, a.plot)
+    try:
+        if a.json:
+            with open(a.json, "w") as f:
+                json.dump({"runs": rows}, f, indent=1)
+        if a.plot:
+            plot(rows, a.plot)
+    except OSError as e:
+        print(f"accuracy_table.py: cannot write {e.filename}: {e.strerror}", file=sys.stderr)
+        return 1
     return 0
 
 

@@ -39,6 +39,7 @@ TEST_PACKAGES=(
   libpetsc3.18-dev-examples         # PETSc's tutorials (reference for the API)
   python3-meshio                    # reads the datasets' XDMF views in a test (tests/python/test_xdmf_views.py)
   python3-torch                     # PyTorch Datasets of the grid and point-cloud forms (scripts/hypershape_torch.py)
+  time                              # /usr/bin/time: the CPU seconds of scripts/bench_groups.sh and study_accuracy_levels.sh
 )
 if [ $# -eq 0 ]; then PACKAGES+=("${TEST_PACKAGES[@]}"); fi
 

@@ -21,6 +21,7 @@ json=${JSON:-docs/accuracy_levels/${preset}_$seed.json}
 png=${PNG:-docs/figures/accuracy_levels_$preset.png}
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
 [ -x "$bin" ] || { echo "study_accuracy_levels.sh: $bin not found (scripts/setup.sh builds it)" >&2; exit 2; }
+[ -x /usr/bin/time ] || { echo "study_accuracy_levels.sh: /usr/bin/time not found (scripts/setup.sh installs it, or: apt-get install -y time)" >&2; exit 2; }
 mkdir -p "$out" "$(dirname "$json")" "$(dirname "$png")"
 runs=()
 run() {  # $1 tag, $2 the accuracy line ("" = the preset as it is, with its estimates)

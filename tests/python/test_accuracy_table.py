@@ -109,6 +109,9 @@ with tempfile.TemporaryDirectory() as tmp:
     r = run("--from-json", times, "--plot", no_png)
     check(r.returncode == 1 and "times.log" in r.stderr and "Traceback" not in r.stderr and not os.path.exists(no_png),
           f"a JSON file it did not write: exit {r.returncode}, {r.stderr.strip()}")
+    r = run("--from-json", rows_json, "--json", os.path.join(tmp, "no_dir", "rows.json"))
+    check(r.returncode == 1 and "no_dir" in r.stderr and "Traceback" not in r.stderr,
+          f"a JSON path it cannot write: exit {r.returncode}, {r.stderr.strip()}")
     r = run(plain, "--times", os.path.join(tmp, "none.log"))
     check(r.returncode == 1 and "none.log" in r.stderr and "Traceback" not in r.stderr,
           f"a times log that is not there: exit {r.returncode}, {r.stderr.strip()}")
