@@ -2,10 +2,11 @@
 """What each accuracy level costs (issue 19, docs/ACCURACY.md "Datasets asked for by accuracy"):
 one row per generated dataset directory, from its run report (reports/*.json: load cases, Newton
 iterations, factorisations, the accuracy block) and its shards (the stored estimates, the level
-each shape kept); CPU seconds from a /usr/bin/time log when given.
+each label and each shape's mesh were kept at); CPU seconds from a /usr/bin/time log when given.
 
   accuracy_table.py DIR... [--times times.log] [--json rows.json] [--plot figure.png]
   accuracy_table.py --from-json rows.json [--plot figure.png]     (the table and figure again)
+  ... --before earlier.json        (the figure also draws an earlier study's cost per bound, dashed)
 
 times.log lines: "<name> cpu_user U cpu_sys S wall W ..." where <name> is DIR's basename less
 "out_" (scripts/study_accuracy_levels.sh writes it). The figure: per run the share of its load
@@ -49,7 +50,7 @@ def dataset(d, cpu):
         raise InputError(f"{d}: not a generated dataset (no reports/*.json or shards/*.h5)")
     rep = json.load(open(reports[0]))
     s, lc = rep["solver"], rep["load_cases"]
-    est, levels, dofs = [], [], []
+    est, levels, labels, dofs = [], [], [], []
     for f in shards:
         with h5py.File(f) as h:
             for g in h["shapes"].values():
@@ -61,6 +62,8 @@ def dataset(d, cpu):
                 levels.append(int(g.attrs.get("accuracy_level", 0)))
                 dofs.append(g["nodes"].shape[0] * g["nodes"].shape[1])
                 st = g["loads/status"][...]
+                if "accuracy_level" in g["loads"]:
+                    labels += [int(k) for k in g["loads/accuracy_level"][...][st == 1]]
                 est += [float(e) for e in g["loads/error_estimate_rel_l2"][...][st == 1]]
     acc = rep.get("accuracy", {})
     name = os.path.basename(os.path.normpath(d)).removeprefix("out2_").removeprefix("out_")
@@ -72,6 +75,7 @@ def dataset(d, cpu):
         "load_cases": lc["converged"] + lc["failed"],
         "share_meeting": acc.get("share_meeting"),
         "shapes_per_level": {str(k): levels.count(k) for k in sorted(set(levels))},
+        "labels_per_level": {str(k): labels.count(k) for k in sorted(set(labels))},
         "mean_unknowns": float(np.mean(dofs)) if dofs else 0.0,
         "newton_per_load_case": s["newton_iterations"] / max(1, n_ok),
         "factorizations_per_load_case": s["numeric_factorizations"] / max(1, n_ok),
@@ -82,19 +86,21 @@ def dataset(d, cpu):
 
 
 def table(rows):
-    lines = ["| run | bound | converged | estimate <= bound | shapes per level | mean unknowns | estimate median / p90 / "
+    lines = ["| run | bound | converged | estimate <= bound | labels per level | shapes per level | mean unknowns | estimate median / p90 / "
              "max | Newton its per load case | factorisations per load case | discarded load cases | CPU s | CPU s per "
              "load case | CPU per load case against the first run |",
-             "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+             "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     base = per_case(rows[0]) if rows else None
     for r in rows:
         e = np.array(r["estimates"])
         est = f"{np.median(e):.3g} / {np.percentile(e, 90):.3g} / {e.max():.3g}" if len(e) else "-"
         meets = f"{100 * r['share_meeting']:.1f}%" if r["share_meeting"] is not None else "-"
-        lv = ", ".join(f"{k}: {n}" for k, n in r["shapes_per_level"].items()) if r["bound"] else "-"
+        levels = lambda key: ", ".join(f"{k}: {n}" for k, n in r.get(key, {}).items()) if r["bound"] else "-"
+        lv = levels("shapes_per_level")
         c, pc = r["cpu_seconds"], per_case(r)
         lines.append(
-            f"| {r['name']} | {r['bound'] if r['bound'] else '-'} | {r['converged']}/{r['load_cases']} | {meets} | {lv} | "
+            f"| {r['name']} | {r['bound'] if r['bound'] else '-'} | {r['converged']}/{r['load_cases']} | {meets} | "
+            f"{levels('labels_per_level') or '-'} | {lv} | "
             f"{r['mean_unknowns']:.0f} | {est} | {r['newton_per_load_case']:.1f} | "
             f"{r['factorizations_per_load_case']:.1f} | {r['discarded_load_cases']} | {f'{c:.0f}' if c else '-'} | "
             f"{f'{pc:.2f}' if pc else '-'} | {f'{pc / base:.1f}x' if pc and base else '-'} |")
@@ -115,13 +121,32 @@ def label(r):
     return f"bound {r['bound']:g}" + ("" if canonical(r) else f" ({r['name']})")
 
 
-def plot(rows, path):
+def read_rows(path):
+    try:
+        return json.load(open(path))["runs"]
+    except (OSError, ValueError, KeyError, TypeError) as e:
+        raise InputError(f"{path}: not a table this script wrote ({e})")
+
+
+def cost_curve(bx, rows, fmt, name, **kw):
+    """CPU per load case against the rows' first run, per canonical bound, its share annotated."""
+    base = per_case(rows[0])
+    main = [r for r in rows if r["bound"] and per_case(r) and canonical(r)]
+    if not base or not main:
+        return
+    bx.plot([r["bound"] for r in main], [per_case(r) / base for r in main], fmt, label=name, **kw)
+    for r in main:
+        bx.annotate(f"{100 * r['share_meeting']:.1f}%", (r["bound"], per_case(r) / base),
+                    textcoords="offset points", xytext=(4, 4), fontsize=8, **kw)
+
+
+def plot(rows, path, before=None, before_name="before"):
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4.2))
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4.8))
     bounds = sorted({r["bound"] for r in rows if r["bound"]})
     for r in rows:
         e = np.sort(np.array([x for x in r["estimates"] if x > 0]))
@@ -138,20 +163,22 @@ def plot(rows, path):
     xs = [r for r in rows if r["bound"] and per_case(r)]
     if base and xs:
         first = np.array(rows[0]["estimates"])
-        main = [r for r in xs if canonical(r)]
-        bx.plot([r["bound"] for r in main], [per_case(r) / base for r in main], "o-", label="asked for by accuracy")
+        cost_curve(bx, rows, "o-", "asked for by accuracy (share meeting the bound)")
+        if before:
+            cost_curve(bx, before, "o--", before_name, color="0.55")
         for r in xs:
             if not canonical(r):
                 bx.plot([r["bound"]], [per_case(r) / base], "x", ms=8, label=label(r))
-            bx.annotate(f"{100 * r['share_meeting']:.0f}% meet", (r["bound"], per_case(r) / base),
-                        textcoords="offset points", xytext=(4, 4), fontsize=8)
+                bx.annotate(f"{100 * r['share_meeting']:.1f}%", (r["bound"], per_case(r) / base),
+                            textcoords="offset points", xytext=(4, 4), fontsize=8)
         if not rows[0]["bound"] and len(first):
             bb = sorted({r["bound"] for r in xs})
             bx.plot(bb, [1.0] * len(bb), "s", color="0.5", label=f"'{rows[0]['name']}' as configured")
             for b in bb:
                 share = np.mean((first >= 0) & (first <= b)) * len(first) / rows[0]["converged"]
                 bx.annotate(f"{100 * share:.0f}%", (b, 1.0), textcoords="offset points", xytext=(4, 4), fontsize=8)
-        bx.legend(fontsize=8, loc="center left")
+        bx.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, frameon=False)
+        bx.margins(x=0.12, y=0.15)
         bx.set(xscale="log", yscale="log", xlabel="bound on the relative L2 error (accuracy: {rel_l2: B})",
                ylabel=f"CPU per load case / '{rows[0]['name']}'", title="what each bound costs")
         bx.invert_xaxis()
@@ -166,13 +193,13 @@ def main():
     ap.add_argument("--json", help="write the rows (with every estimate) here")
     ap.add_argument("--from-json", help="read the rows from a file --json wrote instead of datasets")
     ap.add_argument("--plot", help="write the figure here (PNG)")
+    ap.add_argument("--before", help="an earlier study's rows (a file --json wrote), drawn dashed in the figure")
+    ap.add_argument("--before-name", default="before", help="its legend entry")
     a = ap.parse_args()
     try:
+        before = read_rows(a.before) if a.before else None
         if a.from_json:
-            try:
-                rows = json.load(open(a.from_json))["runs"]
-            except (OSError, ValueError, KeyError, TypeError) as e:
-                raise InputError(f"{a.from_json}: not a table this script wrote ({e})")
+            rows = read_rows(a.from_json)
         elif a.dirs:
             cpu = cpu_seconds(a.times)
             rows = [dataset(d, cpu) for d in a.dirs]
@@ -187,7 +214,7 @@ def main():
             with open(a.json, "w") as f:
                 json.dump({"runs": rows}, f, indent=1)
         if a.plot:
-            plot(rows, a.plot)
+            plot(rows, a.plot, before, a.before_name)
     except OSError as e:
         print(f"accuracy_table.py: cannot write {e.filename}: {e.strerror}", file=sys.stderr)
         return 1

@@ -154,6 +154,8 @@ class Sample:
                    estimated error (relative L2 of u; relative, signed, of max|u| and of alpha;
                    NaN when the dataset has no estimates, 0 for a failed load case, -1 when
                    no estimate could be formed)
+      accuracy_level (int): the accuracy ladder's level the label was solved at (a dataset asked
+                   for by accuracy; 0 otherwise), carried exactly to the shape's stored mesh
       params       dict: drawn scene parameter "<effect label>/<key>" -> its value for this
                    load case (float, or (d,) for a further traction's centre/direction)
     The input channels the scene's effects bring (Dataset.channels: "traction", "body_force",
@@ -177,10 +179,10 @@ class Sample:
 # Per-load-case arrays under "loads/" with one row per load case.
 _LOAD_SCALARS = ("alpha", "target", "max_displacement", "min_det_f", "traction_normaliser",
                  "newton_iterations", "solves", "failed_increments", "recovery_iterations",
-                 "error_estimate_rel_l2", "error_estimate_max_u", "error_estimate_alpha")
+                 "error_estimate_rel_l2", "error_estimate_max_u", "error_estimate_alpha", "accuracy_level")
 # The a posteriori estimates of each label's own error (docs/ACCURACY.md), per load case.
 ERROR_ESTIMATES = ("error_estimate_rel_l2", "error_estimate_max_u", "error_estimate_alpha")
-_LOAD_COUNTS = ("newton_iterations", "solves", "failed_increments", "recovery_iterations")
+_LOAD_COUNTS = ("newton_iterations", "solves", "failed_increments", "recovery_iterations", "accuracy_level")
 
 
 class Dataset:
@@ -702,7 +704,7 @@ def error_estimates(ds, worst=5):
     distribution (quantiles of the magnitude), the `worst` load cases by the relative L2 estimate
     (with their Newton iterations), and how many estimated labels took more than
     NEAR_LIMIT_ITERATIONS x the median Newton iterations. None when the dataset stores no estimates."""
-    rows, its = [], []  # (shape, load, rel_l2, max_u, alpha); Newton iterations
+    rows, its, levels = [], [], []  # (shape, load, rel_l2, max_u, alpha); Newton iterations; ladder levels
     for sid in ds.shape_ids():
         gl = ds._group(sid)["loads"]
         if ERROR_ESTIMATES[0] not in gl:
@@ -712,6 +714,8 @@ def error_estimates(ds, worst=5):
         n_it = gl["newton_iterations"][...]
         rows += [(sid, k, *(float(c[k]) for c in cols)) for k in range(len(st)) if st[k]]
         its += [int(n_it[k]) for k in range(len(st)) if st[k]]
+        if "accuracy_level" in gl:
+            levels += [int(v) for v, k in zip(gl["accuracy_level"][...], st) if k]
     if not rows:
         return None
     a = np.array([r[2:] for r in rows])
@@ -728,6 +732,7 @@ def error_estimates(ds, worst=5):
     dist = {k: {f"p{p}": float(np.percentile(np.abs(a[:, i]), p)) for p in q} for i, k in enumerate(ERROR_ESTIMATES)}
     order = np.argsort(-a[:, 0])[:worst]
     return {"load_cases": len(rows), "without_estimate": missing, "inverted_in_a_cell": inverted,
+            "labels_per_accuracy_level": {k: levels.count(k) for k in sorted(set(levels))},
             "distribution_of_magnitude": dist,
             "worst_by_rel_l2": [{"shape": rows[i][0], "load": rows[i][1], "rel_l2": rows[i][2],
                                  "max_u": rows[i][3], "alpha": rows[i][4],
@@ -746,6 +751,9 @@ def print_error_estimates(e, out=sys.stdout):
     w("    worst load cases by rel_l2: " + ", ".join(
         f"shape {r['shape']} load {r['load']} ({r['rel_l2']:.3g}, {r['newton_iterations']} Newton its)"
         for r in e["worst_by_rel_l2"]))
+    if e.get("labels_per_accuracy_level"):
+        w("    labels per accuracy level (asked for by accuracy): "
+          + ", ".join(f"{k}: {n}" for k, n in e["labels_per_accuracy_level"].items()))
     w(f"    {e['many_newton_iterations']} estimated labels took more than {NEAR_LIMIT_ITERATIONS:g}x the median Newton "
       "iterations: near a limit point of the load an estimate can undershoot (docs/ACCURACY.md)")
 

@@ -124,22 +124,22 @@ ShapeSample refine_shape(const ShapeSample& shape) {
 
 AccuracySummary& AccuracySummary::operator+=(const AccuracySummary& o) {
   for (int k = 0; k < kLevels; ++k) shapes_at_level[std::size_t(k)] += o.shapes_at_level[std::size_t(k)];
-  loads_meeting += o.loads_meeting, loads_exceeding += o.loads_exceeding, escalations += o.escalations;
+  for (int k = 0; k < kLevels; ++k) loads_at_level[std::size_t(k)] += o.loads_at_level[std::size_t(k)];
+  loads_meeting += o.loads_meeting, loads_exceeding += o.loads_exceeding, solved_again += o.solved_again;
   discarded_loads += o.discarded_loads, discarded_newton += o.discarded_newton;
   discarded_factorizations += o.discarded_factorizations;
   return *this;
 }
 
 void AccuracySummary::sum_over(MPI_Comm comm, bool contribute) {
-  std::array<std::int64_t, kLevels + 6> v{}, t{};
-  for (int k = 0; k < kLevels; ++k) v[std::size_t(k)] = shapes_at_level[std::size_t(k)];
-  const std::array<std::int64_t*, 6> rest{&loads_meeting, &loads_exceeding, &escalations, &discarded_loads,
-                                          &discarded_newton, &discarded_factorizations};
-  for (std::size_t i = 0; i < rest.size(); ++i) v[kLevels + i] = *rest[i];
-  if (!contribute) v.fill(0);
+  std::vector<std::int64_t*> all{&loads_meeting, &loads_exceeding, &solved_again, &discarded_loads, &discarded_newton,
+                                 &discarded_factorizations};
+  for (auto& x : shapes_at_level) all.push_back(&x);
+  for (auto& x : loads_at_level) all.push_back(&x);
+  std::vector<std::int64_t> v(all.size()), t(all.size());
+  for (std::size_t i = 0; i < all.size(); ++i) v[i] = contribute ? *all[i] : 0;
   MPI_Allreduce(v.data(), t.data(), int(v.size()), MPI_INT64_T, MPI_SUM, comm);
-  for (int k = 0; k < kLevels; ++k) shapes_at_level[std::size_t(k)] = t[std::size_t(k)];
-  for (std::size_t i = 0; i < rest.size(); ++i) *rest[i] = t[kLevels + i];
+  for (std::size_t i = 0; i < all.size(); ++i) *all[i] = t[i];
 }
 
 std::int64_t AccuracySummary::shapes() const {
@@ -153,10 +153,11 @@ nlohmann::json AccuracySummary::json(const config::AccuracyConfig& a) const {
   return {{"rel_l2_bound", a.rel_l2},
           {"max_level", a.max_level},
           {"shapes_at_level", shapes_at_level},
+          {"load_cases_at_level", loads_at_level},
           {"load_cases_meeting", loads_meeting},
           {"load_cases_exceeding", loads_exceeding},
           {"share_meeting", n ? double(loads_meeting) / double(n) : 0.0},
-          {"escalations", escalations},
+          {"load_cases_solved_again", solved_again},
           {"discarded_load_cases", discarded_loads},
           {"discarded_newton_iterations", discarded_newton},
           {"discarded_numeric_factorizations", discarded_factorizations}};
@@ -165,13 +166,16 @@ nlohmann::json AccuracySummary::json(const config::AccuracyConfig& a) const {
 std::string AccuracySummary::line(const config::AccuracyConfig& a) const {
   if (!a.enabled()) return "";
   const auto n = loads_meeting + loads_exceeding;
-  std::string levels;
-  for (int k = 0; k <= a.max_level && k < kLevels; ++k)
-    levels += fmt::format("{}{}: {}", k ? ", " : "", k, shapes_at_level[std::size_t(k)]);
-  return fmt::format("  accuracy rel_l2 <= {:g}: {} of {} converged load cases meet it ({:.1f}%); shapes per level "
-                     "{}; {} escalations discarded {} load cases ({} Newton iterations, {} factorisations)\n",
-                     a.rel_l2, loads_meeting, n, n ? 100.0 * double(loads_meeting) / double(n) : 0.0, levels,
-                     escalations, discarded_loads, discarded_newton, discarded_factorizations);
+  std::string shapes, labels;
+  for (int k = 0; k <= a.max_level && k < kLevels; ++k) {
+    shapes += fmt::format("{}{}: {}", k ? ", " : "", k, shapes_at_level[std::size_t(k)]);
+    labels += fmt::format("{}{}: {}", k ? ", " : "", k, loads_at_level[std::size_t(k)]);
+  }
+  return fmt::format("  accuracy rel_l2 <= {:g}: {} of {} converged load cases meet it ({:.1f}%); labels per level "
+                     "{}; shapes stored per level {}; {} load cases solved again, {} labels not kept ({} Newton "
+                     "iterations, {} factorisations)\n",
+                     a.rel_l2, loads_meeting, n, n ? 100.0 * double(loads_meeting) / double(n) : 0.0, labels, shapes,
+                     solved_again, discarded_loads, discarded_newton, discarded_factorizations);
 }
 
 }  // namespace hypershape::factory

@@ -105,6 +105,10 @@ void LabelErrors::estimate(MPI_Comm group, const config::DatasetConfig& cfg, con
   }
 }
 
+void LabelErrors::take(std::size_t L, const LabelErrors& o) {
+  rel_l2_[L] = o.rel_l2_[L], max_u_[L] = o.max_u_[L], alpha_[L] = o.alpha_[L];
+}
+
 void LabelErrors::store(std::vector<io::Array>& arrays) const {
   if (!enabled_) return;
   const auto n = std::uint64_t(rel_l2_.size());

@@ -8,6 +8,7 @@
 #include <numeric>
 
 #include "hypershape/core/error.hpp"
+#include "hypershape/core/log.hpp"
 #include "hypershape/factory/accuracy.hpp"
 #include "hypershape/factory/dataset_schema.hpp"
 #include "hypershape/factory/label_error.hpp"
@@ -217,6 +218,13 @@ struct LoadTable {
     solves[L] = r.solves;
     failed_inc[L] = r.failed_increments;
     recovery[L] = r.recovery_iterations;
+  }
+  /// Load case L's row as `o` holds it.
+  void take(std::size_t L, const LoadTable& o) {
+    status[L] = o.status[L], reasons[L] = o.reasons[L], alpha[L] = o.alpha[L], target[L] = o.target[L];
+    max_u[L] = o.max_u[L], min_det[L] = o.min_det[L], normaliser[L] = o.normaliser[L];
+    for (std::size_t k = L * std::size_t(d); k < (L + 1) * std::size_t(d); ++k) p_n[k] = o.p_n[k], g[k] = o.g[k];
+    newton[L] = o.newton[L], solves[L] = o.solves[L], failed_inc[L] = o.failed_inc[L], recovery[L] = o.recovery[L];
   }
   void store(std::vector<io::Array>& arrays, bool has_traction) const {
     const U64 n = U64(status.size()), du = U64(d);
@@ -445,94 +453,132 @@ LoadOutcome solve_load_case(MPI_Comm group, const config::DatasetConfig& cfg, co
   return o;
 }
 
-/// How a shape's load cases went at one discretisation: the converged ones' estimates (-1: none)
-/// and whether the loop was stopped early (the accuracy ladder abandoned the level).
-struct ShapeSolve {
-  std::vector<std::int8_t> status;
-  std::vector<double> rel_l2;
-  bool stopped = false;
+/// One discretisation of a shape (the config's own; in a dataset asked for by accuracy, a rung of
+/// its ladder) and what the load cases solved on it gave: their rows, estimates and cost and
+/// (group root) the converged ones' displacements. The problem is kept after the solves: a label's
+/// stored input channels are those of the problem it was solved on (its traction normaliser).
+struct Level {
+  Level(MPI_Comm group, const config::DatasetConfig& c, ShapeSample s, const LoadCase& first, core::PhaseTimes& times)
+      : cfg(c), shape(std::move(s)), table(c.loads.count, c.shapes.dim), errors(c, c.loads.count),
+        u(std::size_t(c.loads.count)), factorizations(std::size_t(c.loads.count), 0),
+        solved(std::size_t(c.loads.count), 0) {
+    auto t = times.scope("setup");
+    sp = make_shape_problem(group, cfg, shape, first);
+  }
+  config::DatasetConfig cfg;
+  ShapeSample shape;
+  ShapeProblem sp;
+  LoadTable table;
+  LabelErrors errors;
+  std::vector<std::vector<double>> u;          ///< group root: the converged labels' nodal displacement
+  std::vector<std::int64_t> factorizations;    ///< numeric factorisations of each load case solved here
+  std::vector<char> solved;                    ///< 1: the load case was solved here
 };
 
-/// Stops a shape's load-case loop after load case L: (status, estimates so far, L) -> stop.
-using StopRule = std::function<bool(const std::vector<std::int8_t>&, const std::vector<double>&, std::size_t)>;
-
-/// Solves every load case of `shape` (already drawn, its record in out.entry.shape) on the
-/// discretisation of `cfg` and fills `out`, unless `stop` ends the loop (then `out` is partial:
-/// its counters and times are real, its arrays are not to be stored). Collective over `group`.
-ShapeSolve solve_shape(MPI_Comm group, const config::DatasetConfig& cfg, const ShapeSample& shape,
-                       const std::vector<LoadCase>& cases, const StopRule& stop,
-                       const std::function<void(bool)>& on_load, ShapeJobResult& out) {
-  const bool root = core::rank(group) == 0;
-  const int n_loads = cfg.loads.count;
-  ShapeProblem sp;
+/// Solves the load cases `which` of `lv` (the solver set up once for them all) and records them in
+/// `lv`; their solver work goes to out.counters, `on_load(converged)` runs after each. Collective.
+void solve_loads(MPI_Comm group, Level& lv, const std::vector<LoadCase>& cases, const std::vector<int>& which,
+                 const std::function<void(bool)>& on_load, ShapeJobResult& out) {
   std::unique_ptr<solver::NonlinearSolver> nl;
-  {  // the problem, set up once for all load cases
+  {
     auto t = out.times.scope("setup");
-    sp = make_shape_problem(group, cfg, shape, cases[0]);
-    nl = std::make_unique<solver::NonlinearSolver>(*sp.problem, cfg.solver);
+    nl = std::make_unique<solver::NonlinearSolver>(*lv.sp.problem, lv.cfg.solver);
   }
-  out.n_dofs = sp.problem->space().n_dofs_global();
+  P1Start p1(group, lv.cfg, lv.shape);  // built at the first load case it rescues
+  for (int l : which) {
+    const auto L = std::size_t(l);
+    lv.table.set_case(L, cases[L]);
+    lv.solved[L] = 1;
+    LoadOutcome o = solve_load_case(group, lv.cfg, lv.shape, lv.sp, *nl, p1, cases[L], out.times, lv.table.normaliser[L]);
+    lv.table.set_cost(L, o.result);
+    lv.factorizations[L] = o.result.linear.numeric_factorizations;
+    out.counters.add(o.result);
+    lv.table.status[L] = o.ok ? 1 : 0;
+    lv.table.reasons[L] = o.reason;
+    if (on_load) on_load(o.ok);
+    if (!o.ok) continue;  // a failed load case: the row and the fields stay zero, never NaN
+    lv.table.max_u[L] = o.max_u, lv.table.min_det[L] = o.min_det, lv.table.alpha[L] = o.result.alpha;
+    {
+      auto t = out.times.scope("error_estimate");
+      // The coarse level: the factor the solve left (no second coarse factorisation).
+      lv.errors.estimate(group, lv.cfg, lv.shape, cases[0], cases[L], *lv.sp.problem, nl->solution(), o.result.alpha,
+                         [&](Vec x, Vec y, bool refined) { return nl->apply_tangent_factor(x, y, refined); });
+    }
+    lv.u[L] = std::move(o.u.values);
+  }
+  lv.errors.release_estimator();
+}
+
+/// The largest nodal |u| of a displacement field of `d` components.
+double max_norm(const std::vector<double>& u, int d) {
+  double m = 0;
+  for (std::size_t i = 0; i + std::size_t(d) <= u.size(); i += std::size_t(d)) {
+    double s = 0;
+    for (int k = 0; k < d; ++k) s += u[i + std::size_t(k)] * u[i + std::size_t(k)];
+    m = std::max(m, s);
+  }
+  return std::sqrt(m);
+}
+
+/// Stores the shape on level `levels[stored]` (its mesh and representations), load case L's
+/// label taken from levels[from[L]] (a coarser level's displacement carried to the stored mesh
+/// exactly: the levels are nested, P1 in P2 on one mesh, P2 in P2 on the mesh refined; its
+/// max_displacement then counts the stored nodes). Collective over `group` (the load cases'
+/// input channels are evaluated with the problem each label was solved on).
+void store_shape(MPI_Comm group, const std::vector<std::unique_ptr<Level>>& levels, int stored,
+                 const std::vector<int>& from, const std::vector<LoadCase>& cases, ShapeJobResult& out) {
+  const bool root = core::rank(group) == 0;
+  const Level& top = *levels[std::size_t(stored)];
+  const config::DatasetConfig& cfg = top.cfg;
+  const int n_loads = cfg.loads.count, d = cfg.shapes.dim;
+  out.n_dofs = top.sp.problem->space().n_dofs_global();
   auto& arrays = out.entry.arrays;
   Moments moments;
   ShapeFields fields;
   if (root) {
     auto t = out.times.scope("representations");
-    fields = shape_fields(cfg, shape, sp.problem->space(), moments, arrays);
+    fields = shape_fields(cfg, top.shape, top.sp.problem->space(), moments, arrays);
   }
-  P1Start p1(group, cfg, shape);  // built at the first load case it rescues
-  LoadTable table(n_loads, cfg.shapes.dim);
-  LoadFields load_fields(*sp.problem, cfg, fields, n_loads);
-  DrawnParams drawn(cfg, shape.shape_id, n_loads);
-  LabelErrors label_errors(cfg, n_loads);
-  ShapeSolve result;
+  LoadTable table(n_loads, d);
+  LoadFields load_fields(*top.sp.problem, cfg, fields, n_loads);
+  DrawnParams drawn(cfg, top.shape.shape_id, n_loads);
+  LabelErrors errors(cfg, n_loads);
+  std::map<int, sampling::MeshSampler> to_stored;  // root: a coarser level's fields at the stored nodes
   if (root) load_fields.allocate();
   for (int l = 0; l < n_loads; ++l) {
     const auto L = std::size_t(l);
-    table.set_case(L, cases[L]);
-    drawn.add(cases[L]);  // before anything that may fail: one row per load case
-    LoadOutcome o = solve_load_case(group, cfg, shape, sp, *nl, p1, cases[L], out.times, table.normaliser[L]);
-    table.set_cost(L, o.result);
-    out.counters.add(o.result);
-    table.status[L] = o.ok ? 1 : 0;
-    table.reasons[L] = o.reason;
-    (o.ok ? out.counters.loads_ok : out.counters.loads_failed) += 1;
-    if (on_load) on_load(o.ok);
-    if (o.ok) {
-      table.max_u[L] = o.max_u, table.min_det[L] = o.min_det, table.alpha[L] = o.result.alpha;
-      {
-        auto t = out.times.scope("error_estimate");
-        // The coarse level: the factor the solve left (no second coarse factorisation).
-        label_errors.estimate(group, cfg, shape, cases[0], cases[L], *sp.problem, nl->solution(), o.result.alpha,
-                              [&](Vec x, Vec y, bool refined) { return nl->apply_tangent_factor(x, y, refined); });
-      }
-      if (root) {
-        auto t = out.times.scope("representations");
-        load_fields.fill(*sp.problem, L, table.alpha[L], o.u.values, moments);
-        moments.add("alpha", &table.alpha[L], 1, 1);
-      }
-    }  // a failed load case: the row and the fields stay zero, never NaN
-    if (stop) {  // the group root decides (the estimates agree on every rank; one decision all the same)
-      int s = root && stop(table.status, label_errors.rel_l2(), L) ? 1 : 0;
-      MPI_Bcast(&s, 1, MPI_INT, 0, group);
-      if (s) {
-        result.stopped = true;
-        break;
-      }
-    }
-  }
-  result.status = table.status;
-  result.rel_l2 = label_errors.rel_l2();
-  if (root && !result.stopped) {
+    Level& lv = *levels[std::size_t(from[L])];
+    table.take(L, lv.table);
+    errors.take(L, lv.errors);
+    drawn.add(cases[L]);
+    (table.status[L] ? out.counters.loads_ok : out.counters.loads_failed) += 1;
+    if (!table.status[L]) continue;
+    lv.sp.set_load_case(lv.cfg, lv.shape, cases[L]);  // collective: the channels of the label's own problem
+    if (!root) continue;
     auto t = out.times.scope("representations");
-    table.store(arrays, n_tractions(cfg) > 0);
-    load_fields.store(arrays);
-    label_errors.store(arrays);
-    out.label_error = label_errors.summary(table.status);
-    drawn.store(arrays);
-    moments.store(arrays);
-    out.entry.load_reasons = std::move(table.reasons);
+    std::vector<double> u = lv.u[L];
+    if (from[L] != stored) {
+      auto it = to_stored.find(from[L]);
+      if (it == to_stored.end()) {
+        const physics::Space& s = lv.sp.problem->space();
+        it = to_stored.try_emplace(from[L], d, s.degree(), s.canonical_coords(), s.canonical_cells(), lv.shape.boundary,
+                                   fields.nodes).first;
+      }
+      u = it->second.interpolate(u, d);
+      table.max_u[L] = max_norm(u, d);
+    }
+    load_fields.fill(*lv.sp.problem, L, table.alpha[L], u, moments);
+    moments.add("alpha", &table.alpha[L], 1, 1);
   }
-  return result;
+  if (!root) return;
+  auto t = out.times.scope("representations");
+  table.store(arrays, n_tractions(cfg) > 0);
+  load_fields.store(arrays);
+  errors.store(arrays);
+  out.label_error = errors.summary(table.status);
+  drawn.store(arrays);
+  moments.store(arrays);
+  out.entry.load_reasons = table.reasons;
 }
 
 /// The record of a shape as solved (its mesh), without the timings that would make it differ
@@ -544,86 +590,120 @@ io::ShapeRecord solved_record(const ShapeSample& shape) {
   return r;
 }
 
-/// Over the converged load cases at `level`: the largest estimate (-1 when none was formed), the
-/// largest that a higher level is predicted to bring under the bound (curable(); -1: none), and
-/// how many miss the bound.
-struct Worst {
-  double estimate = -1, curable = -1;
-  std::int64_t exceeding = 0;
-};
-Worst worst_estimate(const config::DatasetConfig& cfg, int level, const ShapeSolve& s) {
-  Worst w;
-  for (std::size_t k = 0; k < s.status.size() && k < s.rel_l2.size(); ++k) {
-    if (!s.status[k]) continue;
-    w.estimate = std::max(w.estimate, s.rel_l2[k]);
-    if (!exceeds(cfg.accuracy, s.rel_l2[k])) continue;
-    w.exceeding += 1;
-    if (curable(cfg, level, s.rel_l2[k])) w.curable = std::max(w.curable, s.rel_l2[k]);
+/// What the ladder did on one shape: out.accuracy (the stored level, each label's level, the
+/// labels meeting the bound, the load cases solved again and the labels not kept, with their
+/// cost), the shape's accuracy_* attributes and (`root`: the group root) loads/accuracy_level and
+/// loads/accuracy_tried.
+void summarise_accuracy(const config::DatasetConfig& cfg, const std::vector<std::unique_ptr<Level>>& levels,
+                        int stored, const std::vector<int>& from, const std::vector<int>& tried, bool root,
+                        ShapeJobResult& out) {
+  AccuracySummary& s = out.accuracy;
+  s.shapes_at_level[std::size_t(stored)] += 1;
+  double worst = -1;
+  std::int64_t converged = 0, exceeding = 0, discarded = 0;
+  for (std::size_t L = 0; L < from.size(); ++L) {
+    const Level& kept = *levels[std::size_t(from[L])];
+    if (kept.table.status[L]) {
+      const double e = kept.errors.rel_l2()[L];
+      s.loads_at_level[std::size_t(from[L])] += 1;
+      converged += 1;
+      worst = std::max(worst, e);
+      exceeding += exceeds(cfg.accuracy, e);
+    }
+    s.solved_again += tried[L] > 0;
+    for (std::size_t k = 0; k < levels.size(); ++k) {
+      if (!levels[k] || !levels[k]->solved[L] || int(k) == from[L]) continue;
+      discarded += 1;
+      s.discarded_newton += levels[k]->table.newton[L];
+      s.discarded_factorizations += levels[k]->factorizations[L];
+    }
   }
-  return w;
+  s.discarded_loads += discarded;
+  s.loads_exceeding += exceeding;
+  s.loads_meeting += converged - exceeding;
+  const AccuracyLevel a = accuracy_level(cfg, stored);
+  auto& numbers = out.entry.shape.numbers;
+  numbers["accuracy_level"] = stored;
+  numbers["accuracy_degree"] = a.degree;
+  numbers["accuracy_h"] = a.h;
+  numbers["accuracy_estimate_max"] = worst;
+  numbers["accuracy_exceeding"] = double(exceeding);
+  numbers["accuracy_discarded_load_cases"] = double(discarded);
+  if (!root) return;
+  const auto n = std::uint64_t(from.size());
+  out.entry.arrays.push_back(schema_array("loads/accuracy_level", {n}, std::vector<std::int8_t>(from.begin(), from.end())));
+  out.entry.arrays.push_back(schema_array("loads/accuracy_tried", {n}, std::vector<std::int8_t>(tried.begin(), tried.end())));
 }
 
-/// The accuracy ladder (factory/accuracy.hpp) on one drawn shape: levels are solved until one
-/// meets the bound on all but the allowed share of its load cases, or the last is reached;
-/// the kept level is `out`, the abandoned ones are counted in out.accuracy (and their solver work
-/// and times in out.counters and out.times: they were spent).
+/// The accuracy ladder (factory/accuracy.hpp), load case by load case, on one drawn shape. Every
+/// load case is solved at level 0. One whose estimate misses the bound where a higher level is
+/// predicted to meet it (curable()) is solved again at the lowest such level
+/// (next_accuracy_level()), and so on up to accuracy.max_level; its label is the one with the
+/// smallest estimate it reached (a re-solve that fails, or forms no estimate, or estimates no
+/// lower, keeps the label it had and ends its climb). No load case climbs while at most
+/// floor(exceed_share * loads.count) of the shape's would. The shape is stored on the finest
+/// level a label was kept at, the coarser labels carried to it exactly (store_shape).
 void solve_by_accuracy(MPI_Comm group, const config::DatasetConfig& cfg, const ShapeSample& drawn,
                        const std::vector<LoadCase>& cases, const std::function<void(bool)>& on_load,
                        ShapeJobResult& out) {
   const auto& acc = cfg.accuracy;
-  const auto allowed = std::int64_t(std::floor(acc.exceed_share * double(cfg.loads.count) + 1e-9));
-  int level = 0;
-  const StopRule miss = [&](const std::vector<std::int8_t>& status, const std::vector<double>& est, std::size_t L) {
-    std::int64_t n = 0;
-    for (std::size_t k = 0; k <= L; ++k) n += status[k] && exceeds(acc, est[k]) && curable(cfg, level, est[k]);
-    return n > allowed;
-  };
+  const int n = cfg.loads.count;
+  const auto allowed = std::size_t(std::floor(acc.exceed_share * double(n) + 1e-9));
+  std::vector<std::unique_ptr<Level>> levels(std::size_t(acc.max_level + 1));
   ShapeSample shape = drawn;
   int refinements = 0;
-  for (;;) {
-    const AccuracyLevel a = accuracy_level(cfg, level);
+  auto level = [&](int k) -> Level& {
+    auto& lv = levels[std::size_t(k)];
+    if (lv) return *lv;
+    const AccuracyLevel a = accuracy_level(cfg, k);
     for (; refinements < a.refinements; ++refinements) shape = refine_shape(shape);
     config::DatasetConfig at = cfg;
     at.degree = a.degree;
-    ShapeJobResult attempt;
-    attempt.entry.shape = solved_record(shape);
-    std::vector<char> oks;
-    const bool last = level >= acc.max_level;
-    const ShapeSolve s = solve_shape(group, at, shape, cases, last ? StopRule{} : miss,
-                                     [&](bool ok) { oks.push_back(ok); }, attempt);
-    for (const auto& [name, sec] : attempt.times.all()) out.times.add(name, sec);
-    const Worst worst = worst_estimate(cfg, level, s);
-    const std::int64_t n_exceeding = worst.exceeding;
-    if (!s.stopped) {  // kept: this level is the shape's
-      const core::PhaseTimes times = out.times;
-      SolveCounters spent = out.counters;
-      const AccuracySummary ladder = out.accuracy;
-      out = std::move(attempt);
-      out.times = times;
-      out.counters += spent;  // the abandoned levels' solver work (no load case of theirs counts)
-      out.accuracy = ladder;
-      out.accuracy.shapes_at_level[std::size_t(level)] += 1;
-      out.accuracy.loads_exceeding += n_exceeding;
-      out.accuracy.loads_meeting += out.counters.loads_ok - n_exceeding;
-      auto& numbers = out.entry.shape.numbers;
-      numbers["accuracy_level"] = level;
-      numbers["accuracy_degree"] = a.degree;
-      numbers["accuracy_h"] = a.h;
-      numbers["accuracy_estimate_max"] = worst.estimate;
-      numbers["accuracy_exceeding"] = double(n_exceeding);
-      numbers["accuracy_discarded_load_cases"] = double(out.accuracy.discarded_loads);
-      if (on_load)
-        for (char ok : oks) on_load(ok != 0);
-      return;
+    lv = std::make_unique<Level>(group, at, shape, cases[0], out.times);
+    return *lv;
+  };
+  std::vector<int> from(std::size_t(n), 0), tried(std::size_t(n), 0), next(std::size_t(n), -1);
+  auto estimate = [&](std::size_t L) { return levels[std::size_t(from[L])]->errors.rel_l2()[L]; };
+  // Where load case L climbs from its kept label at level k (-1: it stays).
+  auto climb = [&](std::size_t L, int k) {
+    const double e = estimate(L);
+    return exceeds(acc, e) && curable(cfg, k, e) ? next_accuracy_level(cfg, k, e) : -1;
+  };
+  std::vector<int> todo(static_cast<std::size_t>(n));
+  std::iota(todo.begin(), todo.end(), 0);
+  solve_loads(group, level(0), cases, todo, on_load, out);
+  for (std::size_t L = 0; L < std::size_t(n); ++L)
+    if (levels[0]->table.status[L]) next[L] = climb(L, 0);
+  for (int k = 1; k <= acc.max_level; ++k) {
+    todo.clear();
+    for (int L = 0; L < n; ++L)
+      if (next[std::size_t(L)] >= k) todo.push_back(L);
+    if (todo.size() <= allowed) break;  // no more than the allowed share would climb
+    std::erase_if(todo, [&](int L) { return next[std::size_t(L)] != k; });
+    if (todo.empty()) continue;
+    Level& lv = level(k);
+    solve_loads(group, lv, cases, todo, {}, out);
+    for (int l : todo) {
+      const auto L = std::size_t(l);
+      tried[L] = k, next[L] = -1;
+      const double e = lv.errors.rel_l2()[L], before = estimate(L);
+      if (!lv.table.status[L] || e < 0 || (before >= 0 && e >= before)) {  // the label it had stays
+        core::info(group, "shape {} load {}: keeps its level-{} label (estimate {:.3g}): at level {} it {}",
+                   drawn.shape_id, L, from[L], before, k,
+                   !lv.table.status[L] ? "failed (" + lv.table.reasons[L] + ")"
+                   : e < 0             ? fmt::format("had no estimate ({:g})", e)
+                                       : fmt::format("estimated {:.3g}", e));
+        continue;
+      }
+      from[L] = k;
+      next[L] = climb(L, k);
     }
-    out.accuracy.escalations += 1;
-    out.accuracy.discarded_loads += attempt.counters.loads();
-    out.accuracy.discarded_newton += attempt.counters.newton_iterations;
-    out.accuracy.discarded_factorizations += attempt.counters.linear.numeric_factorizations;
-    attempt.counters.loads_ok = attempt.counters.loads_failed = 0;
-    out.counters += attempt.counters;
-    level = next_accuracy_level(cfg, level, worst.curable);
   }
+  int stored = 0;
+  for (std::size_t L = 0; L < std::size_t(n); ++L) stored = std::max(stored, from[L]);
+  out.entry.shape = solved_record(levels[std::size_t(stored)]->shape);
+  store_shape(group, levels, stored, from, cases, out);
+  summarise_accuracy(cfg, levels, stored, from, tried, core::rank(group) == 0, out);
 }
 
 }  // namespace
@@ -635,8 +715,16 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
   const std::optional<ShapeSample> shape = draw_shape(cfg, base, shape_id, out);
   if (!shape) return out;
   const auto cases = draw_load_cases(*shape, cfg.loads, cfg.seed, n_tractions(cfg));
-  if (cfg.accuracy.enabled()) solve_by_accuracy(group, cfg, *shape, cases, on_load, out);
-  else (void)solve_shape(group, cfg, *shape, cases, {}, on_load, out);
+  if (cfg.accuracy.enabled()) {
+    solve_by_accuracy(group, cfg, *shape, cases, on_load, out);
+    return out;
+  }
+  std::vector<std::unique_ptr<Level>> levels;
+  levels.push_back(std::make_unique<Level>(group, cfg, *shape, cases[0], out.times));
+  std::vector<int> all(std::size_t(cfg.loads.count)), from(all.size(), 0);
+  std::iota(all.begin(), all.end(), 0);
+  solve_loads(group, *levels[0], cases, all, on_load, out);
+  store_shape(group, levels, 0, from, cases, out);
   return out;
 }
 

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Datasets asked for by accuracy (issue 19, config `accuracy: {rel_l2: B}`): a bad block is
-# refused before any work, naming the key; a bound the config's own mesh misses moves every shape
-# up the ladder (P1 -> P2 -> P2 on the mesh refined) until its stored estimates meet it, the
-# level kept recorded per shape (shapes/<id> attributes accuracy_*) and in the run report; a
+# refused before any work, naming the key; a load case whose label misses a bound the config's
+# own mesh cannot meet climbs the ladder (P1 -> P2 -> P2 on the mesh refined) until its estimate
+# meets it, each label's level recorded (loads/accuracy_level), the shape stored on its finest
+# label's level (attributes accuracy_*) with the coarser labels carried to that mesh exactly; a
 # loose bound keeps level 0, whose arrays are those of the same config without the key.
 # Needs HYPERSHAPE_BIN and HYPERSHAPE_SOURCE_DIR (set by CTest).
 . "$(dirname "$0")/lib.sh"
@@ -34,36 +35,39 @@ refuse '{rel_l2: 0.01, max_levle: 2}' 'accuracy.max_levle'
 refuse '{max_level: 2}' 'accuracy.rel_l2'
 refuse '{rel_l2: 0.01, max_level: 9}' 'accuracy.max_level'
 
-# check.py DIR BOUND MIN_LEVEL [MAX_LEVEL]: every shape's level recorded, >= MIN_LEVEL; its stored
-# estimates meet BOUND or are counted in accuracy_exceeding, allowed below MAX_LEVEL (default 2)
-# only where not even MAX_LEVEL is predicted to meet BOUND (P1 -> P2 / 10, / 2 per refinement);
-# the report agrees.
+# check.py DIR BOUND MIN_LEVEL [MAX_LEVEL]: every label's level recorded, >= MIN_LEVEL, the shape
+# stored on the finest; its estimate meets BOUND or is counted in accuracy_exceeding, allowed below
+# MAX_LEVEL (default 2) only where not even MAX_LEVEL is predicted to meet BOUND (P1 -> P2 / 10,
+# / 2 per refinement) or a higher level was tried and did no better; the report agrees.
 cat > "$work/check.py" <<'PY'
 import glob, h5py, json, sys
 import numpy as np
 d, bound, min_level = sys.argv[1], float(sys.argv[2]), int(sys.argv[3])
 max_level = int(sys.argv[4]) if len(sys.argv) > 4 else 2
 reduction = lambda lvl: (10 if lvl == 0 else 1) * 2 ** (max(0, max_level - 1) - max(0, lvl - 1))  # P1 ladder
-levels, meeting, exceeding = [], 0, 0
+levels, labels, meeting, exceeding = [], [0] * 4, 0, 0
 for f in sorted(glob.glob(f"{d}/shards/*.h5")):
     with h5py.File(f) as h:
         for sid, g in h["shapes"].items():
             a = g.attrs
             lvl = int(a["accuracy_level"]); levels.append(lvl)
-            assert lvl >= min_level, (sid, lvl)
+            st = g["loads/status"][...] == 1
+            own, tried = g["loads/accuracy_level"][...][st], g["loads/accuracy_tried"][...][st]
+            assert lvl == own.max() and (own >= min_level).all() and (tried >= own).all(), (sid, lvl, own, tried)
+            for k in own: labels[k] += 1
             assert int(a["accuracy_degree"]) == (1 if lvl == 0 else 2), (sid, dict(a))
             n_cell_nodes = g["cells"].shape[1]
             assert n_cell_nodes == (3 if lvl == 0 else 6), (sid, n_cell_nodes)
-            st = g["loads/status"][...]
-            e = g["loads/error_estimate_rel_l2"][...][st == 1]
-            over = int(((e < 0) | (e > bound)).sum())
-            assert over == int(a["accuracy_exceeding"]), (sid, e, dict(a))
-            # below the last level, only misses that no level is predicted to cure
-            assert lvl == max_level or all(x >= 0 and x / reduction(lvl) > bound for x in e if x < 0 or x > bound), (sid, lvl, e)
+            e = g["loads/error_estimate_rel_l2"][...][st]
+            miss = (e < 0) | (e > bound)
+            assert miss.sum() == int(a["accuracy_exceeding"]), (sid, e, dict(a))
+            for x, k, t in zip(e[miss], own[miss], tried[miss]):  # a miss stays only where no level would cure it
+                assert k == max_level or t > k or (x >= 0 and x / reduction(k) > bound), (sid, x, k, t)
             assert abs(float(a["accuracy_estimate_max"]) - e.max()) < 1e-12, (sid, e, dict(a))
-            meeting += len(e) - over; exceeding += over
+            meeting += len(e) - miss.sum(); exceeding += miss.sum()
 rep = json.load(open(glob.glob(f"{d}/reports/*.json")[0]))["accuracy"]
 assert rep["shapes_at_level"][:3] == [levels.count(k) for k in range(3)], (rep, levels)
+assert rep["load_cases_at_level"] == labels, (rep, labels)
 assert rep["load_cases_meeting"] == meeting and rep["load_cases_exceeding"] == exceeding, (rep, meeting, exceeding)
 print("levels", levels, "meeting", meeting, "exceeding", exceeding, "discarded", rep["discarded_load_cases"])
 PY
@@ -71,7 +75,7 @@ PY
 # A bound P1 at h 0.1 misses (its estimates are 0.1-0.3): every shape moves to P2 or beyond.
 printf '%s\naccuracy: {rel_l2: 0.05}\n' "$base" > "$work/tight.yaml"
 "$bin" generate "$work/tight.yaml" --progress 0 -o "$work/tight" > "$work/tight.txt" 2>&1 || { cat "$work/tight.txt"; fail "generate (tight)"; }
-/usr/bin/python3 "$work/check.py" "$work/tight" 0.05 1 && ok "rel_l2 0.05: every shape above level 0, estimates meet the bound" \
+/usr/bin/python3 "$work/check.py" "$work/tight" 0.05 1 && ok "rel_l2 0.05: every label above level 0, estimates meet the bound" \
   || fail "rel_l2 0.05"
 mpiexec -n 2 "$bin" generate "$work/tight.yaml" --progress 0 -o "$work/tight_np2" > /dev/null 2>&1 || fail "2-rank run (tight)"
 compare "$work/tight" "$work/tight_np2" > "$work/cmp.txt" && ok "2 ranks choose the same levels: the same dataset bit for bit" \
@@ -116,7 +120,9 @@ def arrays(d):
     for f in sorted(glob.glob(f"{d}/shards/*.h5")):
         with h5py.File(f) as h:
             def visit(name, obj):
-                if isinstance(obj, h5py.Dataset) and name.startswith("shapes/"): out[name] = obj[...]
+                if isinstance(obj, h5py.Dataset) and name.startswith("shapes/"):
+                    if "/loads/accuracy_" in name: assert (obj[...] == 0).all(), name  # no label climbed
+                    else: out[name] = obj[...]
             h.visititems(visit)
             for sid, g in h["shapes"].items():
                 assert g.attrs.get("accuracy_level", 0) == 0
@@ -139,4 +145,57 @@ printf '%s\naccuracy: {rel_l2: 0.003, max_level: 1}\n' "$base" > "$work/hopeless
   && /usr/bin/python3 "$work/same.py" "$work/hopeless" "$work/plain" \
   && ok "rel_l2 0.003 with max_level 1: no shape climbs for labels no level would cure, all 6 counted above" \
   || { cat "$work/hopeless.txt"; fail "hopeless bound"; }
+
+# A bound some labels of a shape meet at level 0 and others not (P1 at h 0.1 estimates 0.07-0.28
+# here): only those climb; the shape is stored at level 1 (P2) and the labels kept at level 0 are
+# the config-without-the-key's, carried to the P2 mesh: equal at the vertices (to round-off), the mean of their
+# ends at the edge midpoints; alpha, status, iterations and estimates the same.
+printf '%s\naccuracy: {rel_l2: 0.16, max_level: 1}\n' "$base" > "$work/mixed.yaml"
+"$bin" -q generate "$work/mixed.yaml" --progress 0 -o "$work/mixed" > /dev/null 2>&1 || fail "generate (mixed)"
+/usr/bin/python3 "$work/check.py" "$work/mixed" 0.16 0 1 > /dev/null || fail "rel_l2 0.16: check"
+/usr/bin/python3 - "$work/mixed" "$work/plain" <<'PY' && ok "rel_l2 0.16: only the labels above it climb; those kept at level 0 carried to the P2 mesh exactly" \
+  || fail "per-load-case levels"
+import glob, h5py, sys
+import numpy as np
+def shapes(d):
+    out = {}
+    for f in sorted(glob.glob(f"{d}/shards/*.h5")):
+        h = h5py.File(f)
+        out.update({sid: g for sid, g in h["shapes"].items()})
+    return out
+mixed, plain = shapes(sys.argv[1]), shapes(sys.argv[2])
+carried = 0
+for sid, g in mixed.items():
+    p = plain[sid]
+    own = g["loads/accuracy_level"][...]
+    climbed = own > 0
+    assert (climbed == (p["loads/error_estimate_rel_l2"][...] > 0.16)).all(), (sid, own)
+    if int(g.attrs["accuracy_level"]) == 0: continue
+    x, c, u = g["nodes"][...], g["cells"][...], g["loads/displacement"][...]
+    nv = p["nodes"].shape[0]
+    assert np.array_equal(x[:nv], p["nodes"][...]), sid  # P2 on the same mesh: its vertices first
+    for L in np.flatnonzero(~climbed):
+        carried += 1
+        assert np.abs(u[L, :nv] - p["loads/displacement"][L]).max() < 1e-14, (sid, L)  # round-off of the interpolation
+        for (a, b, m) in [(0, 1, 3), (1, 2, 4), (2, 0, 5)]:
+            assert np.allclose(u[L, c[:, m]], 0.5 * (u[L, c[:, a]] + u[L, c[:, b]]), rtol=0, atol=1e-14), (sid, L)
+        for key in ["status", "alpha", "newton_iterations", "error_estimate_rel_l2", "min_det_f", "traction_normaliser"]:
+            assert g[f"loads/{key}"][L] == p[f"loads/{key}"][L], (sid, L, key)
+        assert np.array_equal(g["loads/traction"][L, :nv], p["loads/traction"][L]), (sid, L)
+    for L in np.flatnonzero(climbed):
+        assert g["loads/error_estimate_rel_l2"][L] < p["loads/error_estimate_rel_l2"][L], (sid, L)
+assert carried > 0, "no shape mixes levels"
+print("labels carried from level 0:", carried)
+PY
+PYTHONPATH="$src/scripts" /usr/bin/python3 - "$work/mixed" <<'PY' && ok "hypershape_data: each sample's accuracy_level, and the summary's labels per level" \
+  || fail "hypershape_data accuracy_level"
+import io, sys
+import numpy as np
+import hypershape_data as hd
+ds = hd.open_dataset(sys.argv[1])
+levels = [s.accuracy_level for s in (ds.sample(k, l) for k in ds.shape_ids() for l in range(ds.n_loads)) if s.status]
+assert sorted(set(levels)) == [0, 1], levels
+out = io.StringIO(); hd.summary(sys.argv[1], out)
+assert f"labels per accuracy level (asked for by accuracy): 0: {levels.count(0)}, 1: {levels.count(1)}" in out.getvalue(), out.getvalue()
+PY
 finish

@@ -109,7 +109,7 @@ TEST_CASE("The accuracy ladder and its prediction", "[factory][accuracy]") {
   CHECK(factory::accuracy_level(c, 1).refinements == 1);
 }
 
-TEST_CASE("A label no level is predicted to bring under the bound does not move its shape", "[factory][accuracy]") {
+TEST_CASE("A label no level is predicted to bring under the bound does not climb", "[factory][accuracy]") {
   // P1 ladder to level 3 (P2, two refinements): the last level is predicted 40x below level 0,
   // 4x below level 1, 2x below level 2.
   const auto c = config::parse_dataset_text(head + "accuracy: {rel_l2: 0.01, max_level: 3}\n", "<test>");

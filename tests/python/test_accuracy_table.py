@@ -2,13 +2,14 @@
   - on two small datasets made here (the same config as configured with its estimates, and asked
     for by accuracy at 0.05) every figure of a row is the datasets' own: converged load cases,
     the share meeting the bound (counted here from the shards' estimates), the levels the shapes
-    kept, Newton iterations and factorisations per load case from the run report, and the CPU
+    and the labels kept, Newton iterations and factorisations per load case from the run report, and the CPU
     seconds per load case and their ratio from the times log;
   - --json keeps every estimate, and --from-json gives the same table again and a figure;
   - a directory that is not a dataset, a dataset without estimates and a JSON file it did not
     write stop it with exit code 1 and a message naming them (no traceback), writing no file;
-  - the shipped study (docs/accuracy_levels/easy_random2d_4242.json) gives the shares
-    docs/ACCURACY.md quotes ("What each bound costs").
+  - the shipped studies (docs/accuracy_levels/easy_random2d_4242.json, load case by load case,
+    and easy_random2d_4242_one_level_per_shape.json) give the shares docs/ACCURACY.md quotes
+    ("What each bound costs"), and --before draws the earlier one beside the other.
 Needs HYPERSHAPE_BIN and HYPERSHAPE_SOURCE_DIR (set by CTest)."""
 import glob
 import json
@@ -44,15 +45,17 @@ def generate(tmp, tag, extra):
 
 
 def shards(d):
-    """converged load cases, their estimates and the shapes' levels, read here."""
-    est, levels = [], []
+    """converged load cases, their estimates, the shapes' levels and the labels' levels, read here."""
+    est, levels, labels = [], [], []
     for f in sorted(glob.glob(f"{d}/shards/*.h5")):
         with h5py.File(f) as h:
             for g in h["shapes"].values():
                 levels.append(int(g.attrs.get("accuracy_level", 0)))
                 st = g["loads/status"][...]
                 est += list(g["loads/error_estimate_rel_l2"][...][st == 1])
-    return np.array(est), levels
+                if "accuracy_level" in g["loads"]:
+                    labels += list(g["loads/accuracy_level"][...][st == 1])
+    return np.array(est), levels, labels
 
 
 def run(*args):
@@ -70,7 +73,7 @@ with tempfile.TemporaryDirectory() as tmp:
     check(r.returncode == 0 and os.path.getsize(png) > 10000, f"table, JSON and figure written: exit {r.returncode} {r.stderr.strip()}")
     rows = {x["name"]: x for x in json.load(open(rows_json))["runs"]}
     for tag, d in (("plain", plain), ("bound", bound)):
-        est, levels = shards(d)
+        est, levels, labels = shards(d)
         rep = json.load(open(glob.glob(f"{d}/reports/*.json")[0]))
         row = rows[tag]
         check(row["converged"] == rep["load_cases"]["converged"] == len(est) and row["load_cases"] == 6,
@@ -81,8 +84,11 @@ with tempfile.TemporaryDirectory() as tmp:
               f"{tag}: Newton its {row['newton_per_load_case']:.2f} and factorisations {row['factorizations_per_load_case']:.2f} per load case from the report")
         want = {str(k): levels.count(k) for k in sorted(set(levels))}
         check(row["shapes_per_level"] == want, f"{tag}: shapes per level {row['shapes_per_level']} (shards: {want})")
+        want = {str(k): labels.count(k) for k in sorted(set(labels))}
+        check(row["labels_per_level"] == want and (tag == "plain") == (not want),
+              f"{tag}: labels per level {row['labels_per_level']} (shards: {want})")
     b = rows["bound"]
-    est, levels = shards(bound)
+    est, levels, labels = shards(bound)
     check(b["bound"] == 0.05 and abs(b["share_meeting"] - np.mean((est >= 0) & (est <= 0.05))) < 1e-12,
           f"bound 0.05: {100 * b['share_meeting']:.0f}% meet it, counted here from the shards")
     check(rows["plain"]["bound"] is None and rows["plain"]["share_meeting"] is None, "the run without a bound has none")
@@ -116,16 +122,33 @@ with tempfile.TemporaryDirectory() as tmp:
     check(r.returncode == 1 and "none.log" in r.stderr and "Traceback" not in r.stderr,
           f"a times log that is not there: exit {r.returncode}, {r.stderr.strip()}")
 
-# The study docs/ACCURACY.md quotes ("What each bound costs"), drawn again from its JSON.
-shipped = os.path.join(src, "docs", "accuracy_levels", "easy_random2d_4242.json")
-r = run("--from-json", shipped)
-rows = {x["name"]: x for x in json.load(open(shipped))["runs"]}
-quoted = {"rel_l2_0.05": "196/200 | 96.4%", "rel_l2_0.03": "196/200 | 94.4%", "rel_l2_0.01": "196/200 | 92.3%"}
-check(r.returncode == 0 and all(f"| {k} | {k[7:]} | {v} |" in r.stdout for k, v in quoted.items()),
-      f"the shipped study's rows are the ones docs/ACCURACY.md quotes: {r.stdout.splitlines()[2:]}")
+# The studies docs/ACCURACY.md quotes ("What each bound costs"), drawn again from their JSON: load
+# case by load case (2026-12-02), and one level per shape before it (2026-12-01).
+def shipped(name, quoted):
+    path = os.path.join(src, "docs", "accuracy_levels", name)
+    r = run("--from-json", path)
+    check(r.returncode == 0 and all(f"| {k} | {k[7:]} | {v} |" in r.stdout for k, v in quoted.items()),
+          f"{name}: the rows docs/ACCURACY.md quotes: {r.stdout.splitlines()[2:]}")
+    return {x["name"]: x for x in json.load(open(path))["runs"]}
+
+
+rows = shipped("easy_random2d_4242.json",
+               {"rel_l2_0.05": "199/200 | 98.0%", "rel_l2_0.03": "199/200 | 97.5%", "rel_l2_0.01": "199/200 | 93.5%"})
+before = shipped("easy_random2d_4242_one_level_per_shape.json",
+                 {"rel_l2_0.05": "196/200 | 96.4%", "rel_l2_0.03": "196/200 | 94.4%", "rel_l2_0.01": "196/200 | 92.3%"})
 first = np.array(rows["preset"]["estimates"])
 shares = [round(100 * np.mean(first <= b), 1) for b in (0.05, 0.03, 0.01)]
-check(rows["preset"]["converged"] == 199 and shares == [97.0, 96.0, 64.3],
-      f"the preset meets 0.05 / 0.03 / 0.01 on {shares}% of its 199 labels, as quoted")
+check(rows["preset"]["converged"] == 199 and shares == [97.0, 96.0, 64.3]
+      and before["preset"]["estimates"] == rows["preset"]["estimates"],
+      f"the preset meets 0.05 / 0.03 / 0.01 on {shares}% of its 199 labels, as quoted, the same labels in both studies")
+with tempfile.TemporaryDirectory() as tmp:
+    png = os.path.join(tmp, "before.png")
+    args = ("--from-json", os.path.join(src, "docs", "accuracy_levels", "easy_random2d_4242.json"), "--before")
+    r = run(*args, os.path.join(src, "docs", "accuracy_levels", "easy_random2d_4242_one_level_per_shape.json"),
+            "--plot", png)
+    check(r.returncode == 0 and os.path.getsize(png) > 10000, f"--before: the figure with the earlier study: {r.stderr.strip()}")
+    r = run(*args, os.path.join(tmp, "none.json"), "--plot", os.path.join(tmp, "no.png"))
+    check(r.returncode == 1 and "none.json" in r.stderr and not os.path.exists(os.path.join(tmp, "no.png")),
+          f"--before a file that is not there: exit {r.returncode}, {r.stderr.strip()}")
 
 sys.exit(1 if checks.failures else 0)

@@ -1,27 +1,28 @@
 #pragma once
-/// Datasets asked for by accuracy (issue 19; config `accuracy: {rel_l2: B}`): each shape is solved
-/// on a ladder of discretisations, from the config's own (level 0) upwards, until the error
-/// estimate of its load cases (factory/label_error.hpp) meets the bound B. All load cases of a
-/// shape share the level (one mesh, one set of per-shape arrays).
+/// Datasets asked for by accuracy (issue 19; config `accuracy: {rel_l2: B}`): each load case is
+/// solved on a ladder of discretisations, from the config's own (level 0) upwards, until the error
+/// estimate of its label (factory/label_error.hpp) meets the bound B.
 ///
 /// The ladder, from the config's `mesh.degree` p and the drawn mesh M (element size h):
 ///   p = 1: level 0 P1 on M, level 1 P2 on M, level k >= 2 P2 on M refined uniformly k - 1 times;
 ///   p = 2: level k P2 on M refined k times.
 /// Uniform refinement (mesh::refine_uniform) keeps the shape: the same polygon / surface, p_D,
 /// patch and load placements (drawn once, from the shape as drawn), so every level solves the
-/// same boundary-value problem and only its discretisation moves.
+/// same boundary-value problem and only its discretisation moves; and the levels are nested
+/// (each one's fields are fields of the next), so a label carries to a finer level exactly.
 ///
-/// Levels are tried in order of need: a level is abandoned as soon as more than
-/// floor(exceed_share * loads.count) of its converged load cases estimate above B where a higher
-/// level is predicted to meet it (curable()), or have no estimate; the next level is the lowest
-/// whose predicted estimate, the worst curable one seen divided by predicted_reduction(), meets
-/// B. A load case that not even the last level is predicted to bring under B is counted above B
-/// and does not move its shape: measured (2026-12-01, EasyRandom2D at B = 0.05), the finer
-/// levels lost or flagged as many labels as they cured, and climbing for such labels made the
-/// run 101x the level-0 run's CPU for a lower share under B than level 0's own (docs/ACCURACY.md,
-/// "What each bound costs"). The last level (accuracy.max_level) is kept whatever its
-/// estimates, its load cases above B counted as such. Every choice is a function of the
-/// estimates, which are functions of the data: 1 rank and 2 ranks choose the same levels.
+/// Load case by load case (factory/shape_job.cpp, since 2026-12-02): every load case is solved at
+/// level 0; one whose estimate misses B where a higher level is predicted to meet it (curable())
+/// is solved again at the lowest level predicted to (next_accuracy_level()), and so on up to
+/// accuracy.max_level. Its label is the one with the smallest estimate it reached: a re-solve
+/// that fails, forms no estimate or estimates no lower keeps the label it had and ends the climb
+/// (measured, 2026-12-01, EasyRandom2D: the finer levels lose or flag some labels that converge
+/// at level 0). No load case of a shape climbs while at most floor(exceed_share * loads.count)
+/// would. The shape is stored on the finest level one of its labels was kept at, the others
+/// carried to that mesh. A load case no level is predicted to bring under B is counted above B and
+/// does not climb (climbing for them cost 101x the level-0 run's CPU for a lower share under B:
+/// docs/ACCURACY.md, "What each bound costs"). Every choice is a function of the estimates, which
+/// are functions of the data: 1 rank and 2 ranks choose the same levels.
 #include <mpi.h>
 
 #include <array>
@@ -51,8 +52,8 @@ AccuracyLevel accuracy_level(const config::DatasetConfig& cfg, int level);
 /// study's scenes, at error order ~1), 2 per uniform refinement (the order 1 the estimate assumes).
 double predicted_reduction(const AccuracyLevel& from, const AccuracyLevel& to);
 
-/// The level to try after `current` when its worst curable estimate was `worst` (< 0: none
-/// formed): the lowest above `current` predicted to meet the bound, at most accuracy.max_level.
+/// The level to try after `current` for a label whose estimate was `worst` (< 0: none formed): the
+/// lowest above `current` predicted to meet the bound, at most accuracy.max_level.
 int next_accuracy_level(const config::DatasetConfig& cfg, int current, double worst);
 
 /// Whether a converged load case's estimate `rel_l2` (-1: none) misses the bound.
@@ -72,12 +73,13 @@ ShapeSample refine_shape(const ShapeSample& shape);
 /// What the accuracy ladder did over a set of shapes (a shape's job, a run report).
 struct AccuracySummary {
   static constexpr int kLevels = 4;
-  std::array<std::int64_t, kLevels> shapes_at_level{};  ///< shapes kept at each level
-  std::int64_t loads_meeting = 0;    ///< converged load cases of kept levels, estimate <= bound
-  std::int64_t loads_exceeding = 0;  ///< converged, estimate > bound or none (kept at max_level)
-  std::int64_t escalations = 0;      ///< levels abandoned
-  std::int64_t discarded_loads = 0;  ///< load cases solved (and estimated) at abandoned levels
-  std::int64_t discarded_newton = 0, discarded_factorizations = 0;
+  std::array<std::int64_t, kLevels> shapes_at_level{};  ///< shapes stored at each level (their finest label's)
+  std::array<std::int64_t, kLevels> loads_at_level{};   ///< converged load cases whose label is of each level
+  std::int64_t loads_meeting = 0;    ///< converged load cases, estimate <= bound
+  std::int64_t loads_exceeding = 0;  ///< converged, estimate > bound or none
+  std::int64_t solved_again = 0;      ///< load cases solved again at a higher level
+  std::int64_t discarded_loads = 0;  ///< labels solved (and estimated) and not kept
+  std::int64_t discarded_newton = 0, discarded_factorizations = 0;  ///< what those cost
   AccuracySummary& operator+=(const AccuracySummary& o);
   /// Summed over `comm`, counting only the ranks where `contribute`. Collective.
   void sum_over(MPI_Comm comm, bool contribute);

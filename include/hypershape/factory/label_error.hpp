@@ -72,6 +72,10 @@ class LabelErrors {
   void estimate(MPI_Comm group, const config::DatasetConfig& cfg, const ShapeSample& shape, const LoadCase& first,
                 const LoadCase& lc, const physics::Problem& coarse, Vec u, double alpha,
                 const solver::CoarseSolve& coarse_solve);
+  /// Load case L's three estimates as `o` holds them.
+  void take(std::size_t L, const LabelErrors& o);
+  /// Frees the estimator (its refined problem); the estimates stay.
+  void release_estimator() { estimator_.reset(); }
   /// Appends the three arrays (group root).
   void store(std::vector<io::Array>& arrays) const;
   bool enabled() const { return enabled_; }
