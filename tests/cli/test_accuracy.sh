@@ -153,6 +153,9 @@ printf '%s\naccuracy: {rel_l2: 0.003, max_level: 1}\n' "$base" > "$work/hopeless
 printf '%s\naccuracy: {rel_l2: 0.16, max_level: 1}\n' "$base" > "$work/mixed.yaml"
 "$bin" -q generate "$work/mixed.yaml" --progress 0 -o "$work/mixed" > /dev/null 2>&1 || fail "generate (mixed)"
 /usr/bin/python3 "$work/check.py" "$work/mixed" 0.16 0 1 > /dev/null || fail "rel_l2 0.16: check"
+mpiexec -n 2 "$bin" -q generate "$work/mixed.yaml" --progress 0 -o "$work/mixed_np2" > /dev/null 2>&1 || fail "2-rank run (mixed)"
+compare "$work/mixed" "$work/mixed_np2" > "$work/cmp.txt" && ok "labels of two levels in a shape: 2 ranks make the same dataset bit for bit" \
+  || { head -20 "$work/cmp.txt"; fail "2 ranks differ from 1 (mixed)"; }
 /usr/bin/python3 - "$work/mixed" "$work/plain" <<'PY' && ok "rel_l2 0.16: only the labels above it climb; those kept at level 0 carried to the P2 mesh exactly" \
   || fail "per-load-case levels"
 import glob, h5py, sys
