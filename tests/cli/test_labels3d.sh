@@ -50,10 +50,11 @@ n_plain=$(vertices "$work/plain.yaml"); n_rim=$(vertices "$work/rim.yaml")
 [ -n "$n_plain" ] && [ -n "$n_rim" ] && [ "$n_rim" -gt "$n_plain" ] ||
   { echo "FAIL: scene mesh.rim: $n_plain vertices without, $n_rim with"; exit 1; }
 echo "ok   scene mesh {surface_h, rim}: $n_plain -> $n_rim vertices"
-scene circle "{degree: 1, h: 0.1, rim: 0.05}" "[1, 0]" > "$work/bad.yaml"
-msg=$("${HYPERSHAPE_BIN}" solve "$work/bad.yaml" -o "$work/b.h5" 2>&1) && { echo "FAIL: rim on a 2D scene accepted"; exit 1; }
-grep -q "rim" <<<"$msg" && grep -q "base: sphere" <<<"$msg" || { echo "FAIL: rim on a 2D scene: $msg"; exit 1; }
-echo "ok   scene mesh.rim on a circle rejected: $(tail -1 <<<"$msg")"
+# A circle scene takes mesh.rim (the patch ends' size, as the 2D datasets' key) but not surface_h.
+scene circle "{degree: 1, h: 0.1, surface_h: 0.05}" "[1, 0]" > "$work/bad.yaml"
+msg=$("${HYPERSHAPE_BIN}" solve "$work/bad.yaml" -o "$work/b.h5" 2>&1) && { echo "FAIL: surface_h on a 2D scene accepted"; exit 1; }
+grep -q "surface_h" <<<"$msg" && grep -q "base: sphere" <<<"$msg" || { echo "FAIL: surface_h on a 2D scene: $msg"; exit 1; }
+echo "ok   scene mesh.surface_h on a circle rejected: $(tail -1 <<<"$msg")"
 
 # r3d-0 is Random3D shape 0 as drawn: its patch centre and load case stay what the study's
 # tables were measured on, whatever the random3d preset's own mesh (a rim there redraws shape 0).
