@@ -470,7 +470,7 @@ struct Level {
   ShapeProblem sp;
   LoadTable table;
   LabelErrors errors;
-  std::vector<std::vector<double>> u;          ///< group root: the converged labels' nodal displacement
+  std::vector<std::vector<double>> u;          ///< group root: the converged labels' nodal displacement (moved out by store_shape)
   std::vector<std::int64_t> factorizations;    ///< numeric factorisations of each load case solved here
   std::vector<char> solved;                    ///< 1: the load case was solved here
 };
@@ -556,7 +556,7 @@ void store_shape(MPI_Comm group, const std::vector<std::unique_ptr<Level>>& leve
     lv.sp.set_load_case(lv.cfg, lv.shape, cases[L]);  // collective: the channels of the label's own problem
     if (!root) continue;
     auto t = out.times.scope("representations");
-    std::vector<double> u = lv.u[L];
+    std::vector<double> u = std::move(lv.u[L]);  // its last use: no second copy of every label
     if (from[L] != stored) {
       auto it = to_stored.find(from[L]);
       if (it == to_stored.end()) {
