@@ -80,6 +80,7 @@ def dataset(d, cpu):
         "newton_per_load_case": s["newton_iterations"] / max(1, n_ok),
         "factorizations_per_load_case": s["numeric_factorizations"] / max(1, n_ok),
         "discarded_load_cases": acc.get("discarded_load_cases", 0),
+        "load_cases_fell_back": acc.get("load_cases_fell_back", 0),
         "cpu_seconds": cpu.get(name),
         "estimates": est,
     }
@@ -102,9 +103,15 @@ def table(rows):
             f"| {r['name']} | {r['bound'] if r['bound'] else '-'} | {r['converged']}/{r['load_cases']} | {meets} | "
             f"{levels('labels_per_level') or '-'} | {lv} | "
             f"{r['mean_unknowns']:.0f} | {est} | {r['newton_per_load_case']:.1f} | "
-            f"{r['factorizations_per_load_case']:.1f} | {r['discarded_load_cases']} | {f'{c:.0f}' if c else '-'} | "
+            f"{r['factorizations_per_load_case']:.1f} | {discarded(r)} | {f'{c:.0f}' if c else '-'} | "
             f"{f'{pc:.2f}' if pc else '-'} | {f'{pc / base:.1f}x' if pc and base else '-'} |")
     return "\n".join(lines)
+
+
+def discarded(r):
+    """Labels not kept, and how many re-solves fell back to a level a jump had skipped."""
+    n = r.get("load_cases_fell_back", 0)
+    return f"{r['discarded_load_cases']}" + (f" ({n} re-solves at a skipped level)" if n else "")
 
 
 def per_case(r):

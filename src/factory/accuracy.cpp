@@ -44,6 +44,62 @@ bool curable(const config::DatasetConfig& cfg, int current, double rel_l2) {
   return rel_l2 / predicted_reduction(accuracy_level(cfg, current), accuracy_level(cfg, last)) <= cfg.accuracy.rel_l2;
 }
 
+LoadLadder::LoadLadder(const config::DatasetConfig& cfg, int n_loads)
+    : cfg_(cfg), allowed_(std::size_t(std::floor(cfg.accuracy.exceed_share * double(n_loads) + 1e-9))),
+      kept_(std::size_t(n_loads), 0), waiting_(std::size_t(n_loads), -1), tried_(std::size_t(n_loads), 0U),
+      estimate_(std::size_t(n_loads), -1.0) {
+  if (cfg.accuracy.max_level >= int(8 * sizeof(unsigned)))
+    throw std::logic_error("LoadLadder: max_level beyond the tried-level mask");
+}
+
+bool LoadLadder::record(int L, int k, bool converged, double estimate) {
+  const auto i = std::size_t(L);
+  tried_[i] |= 1U << k;
+  const double before = estimate_[i];
+  const bool keep = k == 0 || (converged && estimate >= 0 && (before < 0 || estimate < before));
+  if (keep) {
+    kept_[i] = k;
+    estimate_[i] = converged ? estimate : -1.0;
+    waiting_[i] = converged ? climb(L) : -1;
+    return true;
+  }
+  // Not kept: fall back to the highest level between the kept label's and k never tried.
+  waiting_[i] = -1;
+  for (int j = k - 1; j > kept_[i]; --j)
+    if (!tried(L, j)) {
+      waiting_[i] = j;
+      break;
+    }
+  return false;
+}
+
+int LoadLadder::climb(int L) const {
+  const int from = kept(L);
+  const double e = estimate_[std::size_t(L)];
+  if (!exceeds(cfg_.accuracy, e) || !curable(cfg_, from, e)) return -1;
+  for (int k = next_accuracy_level(cfg_, from, e); k <= cfg_.accuracy.max_level; ++k)
+    if (!tried(L, k)) return k;
+  return -1;
+}
+
+int LoadLadder::next(std::vector<int>& loads) const {
+  loads.clear();
+  int lowest = -1;
+  std::size_t waiting = 0;
+  for (int w : waiting_)
+    if (w >= 0) waiting += 1, lowest = lowest < 0 ? w : std::min(lowest, w);
+  if (waiting <= allowed_) return -1;  // no more than the allowed share would climb
+  for (std::size_t L = 0; L < waiting_.size(); ++L)
+    if (waiting_[L] == lowest) loads.push_back(int(L));
+  return lowest;
+}
+
+int LoadLadder::highest_tried(int L) const {
+  int k = 0;
+  for (unsigned m = tried_[std::size_t(L)] >> 1; m; m >>= 1) ++k;
+  return k;
+}
+
 namespace {
 
 /// The fine vertex at the midpoint of each coarse edge (a < b), read from the children's
@@ -126,14 +182,15 @@ AccuracySummary& AccuracySummary::operator+=(const AccuracySummary& o) {
   for (int k = 0; k < kLevels; ++k) shapes_at_level[std::size_t(k)] += o.shapes_at_level[std::size_t(k)];
   for (int k = 0; k < kLevels; ++k) loads_at_level[std::size_t(k)] += o.loads_at_level[std::size_t(k)];
   loads_meeting += o.loads_meeting, loads_exceeding += o.loads_exceeding, solved_again += o.solved_again;
+  fell_back += o.fell_back;
   discarded_loads += o.discarded_loads, discarded_newton += o.discarded_newton;
   discarded_factorizations += o.discarded_factorizations;
   return *this;
 }
 
 void AccuracySummary::sum_over(MPI_Comm comm, bool contribute) {
-  std::vector<std::int64_t*> all{&loads_meeting, &loads_exceeding, &solved_again, &discarded_loads, &discarded_newton,
-                                 &discarded_factorizations};
+  std::vector<std::int64_t*> all{&loads_meeting,   &loads_exceeding,  &solved_again,           &fell_back,
+                                 &discarded_loads, &discarded_newton, &discarded_factorizations};
   for (auto& x : shapes_at_level) all.push_back(&x);
   for (auto& x : loads_at_level) all.push_back(&x);
   std::vector<std::int64_t> v(all.size()), t(all.size());
@@ -158,6 +215,7 @@ nlohmann::json AccuracySummary::json(const config::AccuracyConfig& a) const {
           {"load_cases_exceeding", loads_exceeding},
           {"share_meeting", n ? double(loads_meeting) / double(n) : 0.0},
           {"load_cases_solved_again", solved_again},
+          {"load_cases_fell_back", fell_back},
           {"discarded_load_cases", discarded_loads},
           {"discarded_newton_iterations", discarded_newton},
           {"discarded_numeric_factorizations", discarded_factorizations}};
@@ -172,10 +230,10 @@ std::string AccuracySummary::line(const config::AccuracyConfig& a) const {
     labels += fmt::format("{}{}: {}", k ? ", " : "", k, loads_at_level[std::size_t(k)]);
   }
   return fmt::format("  accuracy rel_l2 <= {:g}: {} of {} converged load cases meet it ({:.1f}%); labels per level "
-                     "{}; shapes stored per level {}; {} load cases solved again, {} labels not kept ({} Newton "
-                     "iterations, {} factorisations)\n",
+                     "{}; shapes stored per level {}; {} load cases solved again ({} at a level skipped), {} labels "
+                     "not kept ({} Newton iterations, {} factorisations)\n",
                      a.rel_l2, loads_meeting, n, n ? 100.0 * double(loads_meeting) / double(n) : 0.0, labels, shapes,
-                     solved_again, discarded_loads, discarded_newton, discarded_factorizations);
+                     solved_again, fell_back, discarded_loads, discarded_newton, discarded_factorizations);
 }
 
 }  // namespace hypershape::factory

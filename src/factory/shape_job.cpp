@@ -635,72 +635,50 @@ void summarise_accuracy(const config::DatasetConfig& cfg, const std::vector<std:
   out.entry.arrays.push_back(schema_array("loads/accuracy_tried", {n}, std::vector<std::int8_t>(tried.begin(), tried.end())));
 }
 
-/// The accuracy ladder (factory/accuracy.hpp), load case by load case, on one drawn shape. Every
-/// load case is solved at level 0. One whose estimate misses the bound where a higher level is
-/// predicted to meet it (curable()) is solved again at the lowest such level
-/// (next_accuracy_level()), and so on up to accuracy.max_level; its label is the one with the
-/// smallest estimate it reached (a re-solve that fails, or forms no estimate, or estimates no
-/// lower, keeps the label it had and ends its climb). No load case climbs while at most
-/// floor(exceed_share * loads.count) of the shape's would. The shape is stored on the finest
-/// level a label was kept at, the coarser labels carried to it exactly (store_shape).
+/// The accuracy ladder (factory/accuracy.hpp), load case by load case, on one drawn shape: the
+/// levels LoadLadder schedules, each set up once, when first needed, on the shape refined as often
+/// as it asks. The shape is stored on the finest level a label was kept at, the coarser labels
+/// carried to it exactly (store_shape).
 void solve_by_accuracy(MPI_Comm group, const config::DatasetConfig& cfg, const ShapeSample& drawn,
                        const std::vector<LoadCase>& cases, const std::function<void(bool)>& on_load,
                        ShapeJobResult& out) {
-  const auto& acc = cfg.accuracy;
   const int n = cfg.loads.count;
-  const auto allowed = std::size_t(std::floor(acc.exceed_share * double(n) + 1e-9));
-  std::vector<std::unique_ptr<Level>> levels(std::size_t(acc.max_level + 1));
-  ShapeSample shape = drawn;
-  int refinements = 0;
+  std::vector<std::unique_ptr<Level>> levels(std::size_t(cfg.accuracy.max_level + 1));
+  std::vector<ShapeSample> refined{drawn};  // [r]: the drawn shape refined r times
   auto level = [&](int k) -> Level& {
     auto& lv = levels[std::size_t(k)];
     if (lv) return *lv;
     const AccuracyLevel a = accuracy_level(cfg, k);
-    for (; refinements < a.refinements; ++refinements) shape = refine_shape(shape);
+    while (int(refined.size()) <= a.refinements) refined.push_back(refine_shape(refined.back()));
     config::DatasetConfig at = cfg;
     at.degree = a.degree;
-    lv = std::make_unique<Level>(group, at, shape, cases[0], out.times);
+    lv = std::make_unique<Level>(group, at, refined[std::size_t(a.refinements)], cases[0], out.times);
     return *lv;
   };
-  std::vector<int> from(std::size_t(n), 0), tried(std::size_t(n), 0), next(std::size_t(n), -1);
-  auto estimate = [&](std::size_t L) { return levels[std::size_t(from[L])]->errors.rel_l2()[L]; };
-  // Where load case L climbs from its kept label at level k (-1: it stays).
-  auto climb = [&](std::size_t L, int k) {
-    const double e = estimate(L);
-    return exceeds(acc, e) && curable(cfg, k, e) ? next_accuracy_level(cfg, k, e) : -1;
-  };
+  LoadLadder ladder(cfg, n);
   std::vector<int> todo(static_cast<std::size_t>(n));
   std::iota(todo.begin(), todo.end(), 0);
-  solve_loads(group, level(0), cases, todo, on_load, out);
-  for (std::size_t L = 0; L < std::size_t(n); ++L)
-    if (levels[0]->table.status[L]) next[L] = climb(L, 0);
-  for (int k = 1; k <= acc.max_level; ++k) {
-    todo.clear();
-    for (int L = 0; L < n; ++L)
-      if (next[std::size_t(L)] >= k) todo.push_back(L);
-    if (todo.size() <= allowed) break;  // no more than the allowed share would climb
-    std::erase_if(todo, [&](int L) { return next[std::size_t(L)] != k; });
-    if (todo.empty()) continue;
+  for (int k = 0; k >= 0; k = ladder.next(todo)) {
     Level& lv = level(k);
-    solve_loads(group, lv, cases, todo, {}, out);
+    for (int l : todo) out.accuracy.fell_back += ladder.falls_back(l);
+    solve_loads(group, lv, cases, todo, k == 0 ? on_load : std::function<void(bool)>{}, out);
     for (int l : todo) {
       const auto L = std::size_t(l);
-      tried[L] = k, next[L] = -1;
-      const double e = lv.errors.rel_l2()[L], before = estimate(L);
-      if (!lv.table.status[L] || e < 0 || (before >= 0 && e >= before)) {  // the label it had stays
-        core::info(group, "shape {} load {}: keeps its level-{} label (estimate {:.3g}): at level {} it {}",
-                   drawn.shape_id, L, from[L], before, k,
-                   !lv.table.status[L] ? "failed (" + lv.table.reasons[L] + ")"
-                   : e < 0             ? fmt::format("had no estimate ({:g})", e)
-                                       : fmt::format("estimated {:.3g}", e));
-        continue;
-      }
-      from[L] = k;
-      next[L] = climb(L, k);
+      const int had = ladder.kept(l);
+      const double before = levels[std::size_t(had)]->errors.rel_l2()[L], e = lv.errors.rel_l2()[L];
+      if (ladder.record(l, k, lv.table.status[L] != 0, e)) continue;
+      core::info(group, "shape {} load {}: keeps its level-{} label (estimate {:.3g}): at level {} it {}{}",
+                 drawn.shape_id, L, had, before, k,
+                 !lv.table.status[L] ? "failed (" + lv.table.reasons[L] + ")"
+                 : e < 0             ? fmt::format("had no estimate ({:g})", e)
+                                     : fmt::format("estimated {:.3g}", e),
+                 ladder.waiting(l) >= 0 ? fmt::format("; it tries level {}, which it skipped", ladder.waiting(l)) : "");
     }
   }
-  int stored = 0;
-  for (std::size_t L = 0; L < std::size_t(n); ++L) stored = std::max(stored, from[L]);
+  const std::vector<int>& from = ladder.kept_levels();
+  std::vector<int> tried(static_cast<std::size_t>(n));
+  for (int L = 0; L < n; ++L) tried[std::size_t(L)] = ladder.highest_tried(L);
+  const int stored = *std::max_element(from.begin(), from.end());
   out.entry.shape = solved_record(levels[std::size_t(stored)]->shape);
   store_shape(group, levels, stored, from, cases, out);
   summarise_accuracy(cfg, levels, stored, from, tried, core::rank(group) == 0, out);

@@ -9,6 +9,7 @@
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "hypershape/config/dataset.hpp"
 #include "hypershape/core/input_error.hpp"
@@ -123,6 +124,76 @@ TEST_CASE("A label no level is predicted to bring under the bound does not climb
   CHECK(factory::curable(c, 2, -2));
   CHECK_FALSE(factory::curable(c, 3, -1));  // nothing above the last level
   CHECK_FALSE(factory::curable(c, 3, 0.011));
+}
+
+TEST_CASE("The load-case ladder: who climbs, to which level, and the fall-back after a failed jump",
+          "[factory][accuracy]") {
+  // P1 ladder to level 3; bound 0.01. Level 0 -> 1 is predicted 10x, -> 2 20x, -> 3 40x.
+  const auto c = config::parse_dataset_text(head + "accuracy: {rel_l2: 0.01, max_level: 3}\n", "<test>");
+  factory::LoadLadder ladder(c, 5);
+  std::vector<int> loads;
+  CHECK(ladder.record(0, 0, true, 0.005));  // meets the bound
+  CHECK(ladder.record(1, 0, true, 0.05));   // -> 1
+  CHECK(ladder.record(2, 0, true, 0.15));   // -> 2 (skips 1)
+  CHECK(ladder.record(3, 0, true, 0.5));    // incurable: 0.5 / 40 misses
+  CHECK(ladder.record(4, 0, false, -1));    // failed at level 0: no label, no climb
+  CHECK(ladder.waiting(0) == -1);
+  CHECK(ladder.waiting(3) == -1);
+  CHECK(ladder.waiting(4) == -1);
+  REQUIRE(ladder.next(loads) == 1);
+  CHECK(loads == std::vector<int>{1});
+  CHECK(ladder.record(1, 1, true, 0.008));  // kept, meets it
+  CHECK(ladder.waiting(1) == -1);
+  REQUIRE(ladder.next(loads) == 2);
+  CHECK(loads == std::vector<int>{2});
+  // The jump fails: the label of level 0 stays, and the level it skipped is tried.
+  CHECK_FALSE(ladder.record(2, 2, false, -1));
+  CHECK(ladder.kept(2) == 0);
+  CHECK(ladder.falls_back(2));
+  CHECK_FALSE(ladder.falls_back(1));
+  REQUIRE(ladder.next(loads) == 1);
+  CHECK(loads == std::vector<int>{2});
+  // At level 1 it estimates lower but still misses: it climbs past the failed level 2 to 3.
+  CHECK(ladder.record(2, 1, true, 0.012));
+  CHECK(ladder.kept(2) == 1);
+  CHECK_FALSE(ladder.falls_back(2));  // climbs on, past the level that failed
+  REQUIRE(ladder.next(loads) == 3);
+  CHECK(loads == std::vector<int>{2});
+  CHECK_FALSE(ladder.record(2, 3, true, 0.013));  // no lower: level 1's label stays; nothing skipped
+  CHECK(ladder.next(loads) == -1);
+  CHECK(ladder.kept_levels() == std::vector<int>{0, 1, 1, 0, 0});
+  CHECK(ladder.highest_tried(2) == 3);
+  CHECK(ladder.highest_tried(1) == 1);
+  CHECK(ladder.highest_tried(3) == 0);
+}
+
+TEST_CASE("The load-case ladder: a failed step to the next level ends the climb; the share allowed above stays",
+          "[factory][accuracy]") {
+  const auto c = config::parse_dataset_text(head + "accuracy: {rel_l2: 0.01, max_level: 3}\n", "<test>");
+  factory::LoadLadder ladder(c, 2);
+  std::vector<int> loads;
+  ladder.record(0, 0, true, 0.05);
+  ladder.record(1, 0, true, -2);  // converged, no estimate: one level up
+  REQUIRE(ladder.next(loads) == 1);
+  CHECK(loads == std::vector<int>{0, 1});
+  CHECK_FALSE(ladder.record(0, 1, true, 0.06));  // no lower, and no level skipped: stays at 0
+  CHECK(ladder.waiting(0) == -1);
+  CHECK(ladder.record(1, 1, true, 0.3));  // any estimate beats none; 0.3 / 4 misses: stays
+  CHECK(ladder.waiting(1) == -1);
+  CHECK(ladder.next(loads) == -1);
+  CHECK(loads.empty());
+  CHECK(ladder.kept_levels() == std::vector<int>{0, 1});
+
+  // exceed_share 0.25 of 4 load cases: one may stay above the bound, so one alone does not climb.
+  const auto s = config::parse_dataset_text(head + "accuracy: {rel_l2: 0.01, max_level: 3, exceed_share: 0.25}\n",
+                                            "<test>");
+  factory::LoadLadder shared(s, 4);
+  for (int L = 0; L < 4; ++L) shared.record(L, 0, true, L == 2 ? 0.05 : 0.001);
+  CHECK(shared.waiting(2) == 1);
+  CHECK(shared.next(loads) == -1);
+  shared.record(3, 0, true, 0.02);  // recorded again (a test only): two wait, so both climb
+  CHECK(shared.next(loads) == 1);
+  CHECK(loads == std::vector<int>{2, 3});
 }
 
 TEST_CASE("grade_shape keeps the polygon and its patch and grades the mesh towards the clamp ends",

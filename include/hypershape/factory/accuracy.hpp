@@ -11,14 +11,14 @@
 /// same boundary-value problem and only its discretisation moves; and the levels are nested
 /// (each one's fields are fields of the next), so a label carries to a finer level exactly.
 ///
-/// Load case by load case (factory/shape_job.cpp, since 2026-12-02): every load case is solved at
-/// level 0; one whose estimate misses B where a higher level is predicted to meet it (curable())
-/// is solved again at the lowest level predicted to (next_accuracy_level()), and so on up to
-/// accuracy.max_level. Its label is the one with the smallest estimate it reached: a re-solve
-/// that fails, forms no estimate or estimates no lower keeps the label it had and ends the climb
-/// (measured, 2026-12-01, EasyRandom2D: the finer levels lose or flag some labels that converge
-/// at level 0). No load case of a shape climbs while at most floor(exceed_share * loads.count)
-/// would. The shape is stored on the finest level one of its labels was kept at, the others
+/// Load case by load case (LoadLadder, factory/shape_job.cpp, since 2026-12-02): every load case
+/// is solved at level 0; one whose estimate misses B where a higher level is predicted to meet it
+/// (curable()) is solved again at the lowest level predicted to (next_accuracy_level()), and so on
+/// up to accuracy.max_level. Its label is the one with the smallest estimate it reached: a
+/// re-solve that fails, forms no estimate or estimates no lower keeps the label it had and ends
+/// the climb (measured, 2026-12-01, EasyRandom2D: the finer levels lose or flag some labels that
+/// converge at level 0), unless it jumped past a level it never tried, which it then tries. No
+/// load case of a shape climbs while at most floor(exceed_share * loads.count) would. The shape is stored on the finest level one of its labels was kept at, the others
 /// carried to that mesh. A load case no level is predicted to bring under B is counted above B and
 /// does not climb (climbing for them cost 101x the level-0 run's CPU for a lower share under B:
 /// docs/ACCURACY.md, "What each bound costs"). Every choice is a function of the estimates, which
@@ -64,6 +64,43 @@ inline bool exceeds(const config::AccuracyConfig& a, double rel_l2) { return rel
 /// the bound.
 bool curable(const config::DatasetConfig& cfg, int current, double rel_l2);
 
+/// The ladder's schedule for the load cases of one shape (not collective: every rank of a group
+/// records the same outcomes, so keeps the same schedule). Every load case is first solved at level
+/// 0; then, while more than floor(exceed_share * loads) load cases wait, those waiting for the
+/// lowest level are solved there (next()), and each outcome is recorded (record()).
+///
+/// A load case waits for the lowest level above its kept label's predicted to meet the bound
+/// (next_accuracy_level()), when its label misses it and is curable() and that level is untried.
+/// A re-solve whose label is not kept (it failed, formed no estimate or estimated no lower) ends
+/// the climb, except after a jump past levels it never tried: then it falls back to the highest
+/// of those (measured on Random2D at 0.01, 2026-12-02: jumps from level 0 to 2 that failed there,
+/// of labels that met the bound at level 1 in another run).
+class LoadLadder {
+ public:
+  LoadLadder(const config::DatasetConfig& cfg, int n_loads);
+  /// Load case L solved at level k: whether it converged and its estimate (< 0: none). Returns
+  /// whether its label is the one kept (level 0's always is; a higher level's when it converged
+  /// with an estimate lower than the kept label's, or the kept one had none).
+  bool record(int L, int k, bool converged, double estimate);
+  /// The level to solve next (-1: none; the shape is done) and, in `loads`, the load cases to
+  /// solve there.
+  int next(std::vector<int>& loads) const;
+  int kept(int L) const { return kept_[std::size_t(L)]; }             ///< the kept label's level
+  int waiting(int L) const { return waiting_[std::size_t(L)]; }       ///< the level L waits for (-1: none)
+  bool falls_back(int L) const { return waiting(L) >= 0 && waiting(L) < highest_tried(L); }  ///< to a level it skipped
+  int highest_tried(int L) const;                                     ///< the highest level L was solved at
+  const std::vector<int>& kept_levels() const { return kept_; }
+
+ private:
+  bool tried(int L, int k) const { return (tried_[std::size_t(L)] >> k) & 1U; }
+  int climb(int L) const;  ///< where L waits for from its kept label (-1: it stays)
+  const config::DatasetConfig& cfg_;
+  std::size_t allowed_;
+  std::vector<int> kept_, waiting_;
+  std::vector<unsigned> tried_;  ///< bit k: solved at level k
+  std::vector<double> estimate_;  ///< the kept label's (-1: none yet or failed)
+};
+
 /// `shape` on its mesh refined uniformly once: the boundary's facets split (2 per segment, 4 per
 /// triangle, orientation kept) and renumbered so that boundary point i is still mesh vertex i,
 /// the Dirichlet facets their children; p_D, r, metrics and the draw's record unchanged. Not
@@ -78,6 +115,7 @@ struct AccuracySummary {
   std::int64_t loads_meeting = 0;    ///< converged load cases, estimate <= bound
   std::int64_t loads_exceeding = 0;  ///< converged, estimate > bound or none
   std::int64_t solved_again = 0;      ///< load cases solved again at a higher level
+  std::int64_t fell_back = 0;         ///< re-solves at a level a load case had jumped past (LoadLadder)
   std::int64_t discarded_loads = 0;  ///< labels solved (and estimated) and not kept
   std::int64_t discarded_newton = 0, discarded_factorizations = 0;  ///< what those cost
   AccuracySummary& operator+=(const AccuracySummary& o);
