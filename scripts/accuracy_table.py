@@ -111,7 +111,7 @@ def table(rows):
 def discarded(r):
     """Labels not kept, and how many re-solves fell back to a level a jump had skipped."""
     n = r.get("load_cases_fell_back", 0)
-    return f"{r['discarded_load_cases']}" + (f" ({n} re-solves at a skipped level)" if n else "")
+    return f"{r['discarded_load_cases']}" + (f" ({n} re-solve{'s' * (n != 1)} at a skipped level)" if n else "")
 
 
 def per_case(r):
