@@ -60,11 +60,12 @@ bool LoadLadder::record(int L, int k, bool converged, double estimate) {
   if (keep) {
     kept_[i] = k;
     estimate_[i] = converged ? estimate : -1.0;
-    waiting_[i] = converged ? climb(L) : -1;
+    waiting_[i] = converged ? climb(L, k, estimate_[i]) : -1;
     return true;
   }
-  // Not kept: fall back to the highest level between the kept label's and k never tried.
-  waiting_[i] = -1;
+  // Not kept: fall back to the highest level between the kept label's and k never tried; else,
+  // if it converged, climb on from its own estimate.
+  waiting_[i] = converged ? climb(L, k, estimate) : -1;
   for (int j = k - 1; j > kept_[i]; --j)
     if (!tried(L, j)) {
       waiting_[i] = j;
@@ -73,9 +74,7 @@ bool LoadLadder::record(int L, int k, bool converged, double estimate) {
   return false;
 }
 
-int LoadLadder::climb(int L) const {
-  const int from = kept(L);
-  const double e = estimate_[std::size_t(L)];
+int LoadLadder::climb(int L, int from, double e) const {
   if (!exceeds(cfg_.accuracy, e) || !curable(cfg_, from, e)) return -1;
   for (int k = next_accuracy_level(cfg_, from, e); k <= cfg_.accuracy.max_level; ++k)
     if (!tried(L, k)) return k;

@@ -672,7 +672,9 @@ void solve_by_accuracy(MPI_Comm group, const config::DatasetConfig& cfg, const S
                  !lv.table.status[L] ? "failed (" + lv.table.reasons[L] + ")"
                  : e < 0             ? fmt::format("had no estimate ({:g})", e)
                                      : fmt::format("estimated {:.3g}", e),
-                 ladder.waiting(l) >= 0 ? fmt::format("; it tries level {}, which it skipped", ladder.waiting(l)) : "");
+                 ladder.waiting(l) < 0     ? std::string()
+                 : ladder.falls_back(l)    ? fmt::format("; it tries level {}, which it skipped", ladder.waiting(l))
+                                           : fmt::format("; it climbs on to level {}", ladder.waiting(l)));
     }
   }
   const std::vector<int>& from = ladder.kept_levels();

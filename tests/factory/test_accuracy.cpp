@@ -176,7 +176,7 @@ TEST_CASE("The load-case ladder: a failed step to the next level ends the climb;
   ladder.record(1, 0, true, -2);  // converged, no estimate: one level up
   REQUIRE(ladder.next(loads) == 1);
   CHECK(loads == std::vector<int>{0, 1});
-  CHECK_FALSE(ladder.record(0, 1, true, 0.06));  // no lower, and no level skipped: stays at 0
+  CHECK_FALSE(ladder.record(0, 1, true, 0.06));  // no lower, and not curable from level 1 (0.06 / 4): stays at 0
   CHECK(ladder.waiting(0) == -1);
   CHECK(ladder.record(1, 1, true, 0.3));  // any estimate beats none; 0.3 / 4 misses: stays
   CHECK(ladder.waiting(1) == -1);
@@ -194,6 +194,30 @@ TEST_CASE("The load-case ladder: a failed step to the next level ends the climb;
   shared.record(3, 0, true, 0.02);  // recorded again (a test only): two wait, so both climb
   CHECK(shared.next(loads) == 1);
   CHECK(loads == std::vector<int>{2, 3});
+}
+
+TEST_CASE("The load-case ladder: a converged re-solve not kept climbs on from its own estimate; a failed one stops",
+          "[factory][accuracy]") {
+  const auto c = config::parse_dataset_text(head + "accuracy: {rel_l2: 0.01, max_level: 3}\n", "<test>");
+  factory::LoadLadder ladder(c, 3);
+  std::vector<int> loads;
+  for (int L = 0; L < 3; ++L) ladder.record(L, 0, true, 0.02);  // 0.02 / 10: all wait for level 1
+  REQUIRE(ladder.next(loads) == 1);
+  CHECK_FALSE(ladder.record(0, 1, true, 0.025));  // no lower; from level 1, 0.025 / 4 meets: on to 3 (/2 misses)
+  CHECK(ladder.waiting(0) == 3);
+  CHECK_FALSE(ladder.falls_back(0));
+  CHECK_FALSE(ladder.record(1, 1, true, -2));  // converged, no estimate: one level up
+  CHECK(ladder.waiting(1) == 2);
+  CHECK_FALSE(ladder.record(2, 1, false, -1));  // failed, nothing skipped: the climb ends
+  CHECK(ladder.waiting(2) == -1);
+  REQUIRE(ladder.next(loads) == 2);
+  CHECK(loads == std::vector<int>{1});
+  CHECK(ladder.record(1, 2, true, 0.004));  // lower than level 0's 0.02: kept
+  REQUIRE(ladder.next(loads) == 3);
+  CHECK(loads == std::vector<int>{0});
+  CHECK(ladder.record(0, 3, true, 0.008));
+  CHECK(ladder.next(loads) == -1);
+  CHECK(ladder.kept_levels() == std::vector<int>{3, 2, 0});
 }
 
 TEST_CASE("grade_shape keeps the polygon and its patch and grades the mesh towards the clamp ends",
