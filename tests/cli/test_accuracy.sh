@@ -69,7 +69,7 @@ rep = json.load(open(glob.glob(f"{d}/reports/*.json")[0]))["accuracy"]
 assert rep["shapes_at_level"][:3] == [levels.count(k) for k in range(3)], (rep, levels)
 assert rep["load_cases_at_level"] == labels, (rep, labels)
 assert rep["load_cases_meeting"] == meeting and rep["load_cases_exceeding"] == exceeding, (rep, meeting, exceeding)
-assert 0 <= rep["load_cases_fell_back"] <= rep["load_cases_solved_again"] * 2, rep  # at most one per skipped level
+assert 0 <= rep["load_cases_fell_back"] <= rep["load_cases_solved_again"], rep  # max_level <= 2: at most one per load case
 print("levels", levels, "meeting", meeting, "exceeding", exceeding, "discarded", rep["discarded_load_cases"])
 PY
 
