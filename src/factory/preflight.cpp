@@ -36,8 +36,8 @@ DatasetEstimate estimate_dataset(const config::DatasetConfig& cfg, const std::op
   // per volume. 2D: shape 0's mesh (without a draw: 2.5 of the box's 4, 1.15 / h^2 per area).
   // P2 adds edge nodes (x4 in 2D, x8 in 3D); a uniform refinement multiplies the vertices by 4 / 8.
   // A dataset asked for by accuracy: at its ladder's level 1 (a shape is stored at its finest
-  // label's level, known only once it is solved; Random2D at rel_l2 0.01 stored 3 of 8 shapes at
-  // level 2, 4x these sizes, and 1 at level 0: docs/ACCURACY.md).
+  // label's level, known only once it is solved; Random2D at rel_l2 0.01 stored 5 of 8 shapes at
+  // level 2, 4x these sizes, and 3 at level 1 (2026-12-02, session 68): docs/ACCURACY.md).
   const int d = cfg.shapes.dim;
   const AccuracyLevel level = accuracy_level(cfg, cfg.accuracy.enabled() ? std::min(1, cfg.accuracy.max_level) : 0);
   const double h = level.h;
