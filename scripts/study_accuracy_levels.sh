@@ -8,7 +8,8 @@
 #     NP=2 (ranks); OUT=results/accuracy_levels/PRESET_SEED (the datasets, times.log, the table);
 #     JSON=docs/accuracy_levels/PRESET_SEED.json and PNG=docs/figures/accuracy_levels_PRESET.png
 #     (where the table's rows and its figure go); HYPERSHAPE=build/hypershape; BEFORE=an earlier
-#     study's JSON (drawn dashed in the figure, named BEFORE_NAME).
+#     study's JSON (drawn dashed in the figure, named BEFORE_NAME); ACCURACY_KEYS=more keys of the
+#     accuracy block (e.g. "start: rest").
 # A run already complete is not generated again (the factory finds it complete), so a stopped
 # study resumes where it was; its CPU seconds are those of the run that finished it.
 set -euo pipefail
@@ -44,7 +45,7 @@ run() {  # $1 tag, $2 the accuracy line ("" = the preset as it is, with its esti
   runs+=("$out/$1")
 }
 run preset ""
-for b in $bounds; do run "rel_l2_$b" "accuracy: {rel_l2: $b}"; done
+for b in $bounds; do run "rel_l2_$b" "accuracy: {rel_l2: $b${ACCURACY_KEYS:+, $ACCURACY_KEYS}}"; done
 before=()
 [ -z "${BEFORE:-}" ] || before=(--before "$BEFORE" --before-name "${BEFORE_NAME:-before}")
 /usr/bin/python3 scripts/accuracy_table.py "${runs[@]}" --times "$out/times.log" --json "$json" --plot "$png" "${before[@]}" \

@@ -462,7 +462,14 @@ void parse_accuracy(const YamlBlock& top, const std::string& source, DatasetConf
     if (!(acc.exceed_share >= 0 && acc.exceed_share <= 0.5))
       a.fail("exceed_share", "must be in [0, 0.5] (share of a shape's load cases allowed above the bound)");
   }
-  a.allowed("rel_l2, max_level, exceed_share");
+  if (a.has("start")) {
+    const std::string start = a.text("start");
+    if (start != "coarse" && start != "rest")
+      a.fail("start", "must be coarse (a re-solve on the label's mesh refined once starts from its estimate's fine "
+                      "state) or rest (every re-solve from rest)");
+    acc.start_from_coarse = start == "coarse";
+  }
+  a.allowed("rel_l2, max_level, exceed_share, start");
   a.check_all_used();
   const YAML::Node rep = top.get("representations");
   if (rep && rep["error_estimate"] && !c.representations.error_estimate)

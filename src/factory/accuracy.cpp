@@ -6,6 +6,7 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <numeric>
 #include <stdexcept>
 
 #include "hypershape/geometry/boundary.hpp"
@@ -128,6 +129,28 @@ const std::vector<std::array<int, 3>>& facet_children(int d) {
 }
 
 }  // namespace
+
+std::vector<std::int64_t> node_permutation(const std::vector<double>& from, const std::vector<double>& to, int dim) {
+  const std::size_t d = std::size_t(dim), n = from.size() / d;
+  if (from.size() != to.size() || n * d != from.size()) return {};
+  auto sorted = [&](const std::vector<double>& x) {
+    std::vector<std::int64_t> order(n);
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(), [&](std::int64_t a, std::int64_t b) {
+      return std::lexicographical_compare(&x[std::size_t(a) * d], &x[std::size_t(a) * d] + d, &x[std::size_t(b) * d],
+                                          &x[std::size_t(b) * d] + d);
+    });
+    return order;
+  };
+  const auto a = sorted(from), b = sorted(to);
+  std::vector<std::int64_t> p(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!std::equal(&from[std::size_t(a[i]) * d], &from[std::size_t(a[i]) * d] + d, &to[std::size_t(b[i]) * d]))
+      return {};
+    p[std::size_t(b[i])] = a[i];
+  }
+  return p;
+}
 
 ShapeSample refine_shape(const ShapeSample& shape) {
   const int d = shape.mesh.dim;

@@ -254,8 +254,7 @@ OutputState prepare_run(MPI_Comm comm, const config::DatasetConfig& cfg, const G
   if (opt.group_size < 1 || opt.group_size > size)
     throw core::InputError("", "--group-size", fmt::format("must be in [1, {}] (the number of ranks)", size));
   check_petsc_options(cfg, user_options(cfg, opt.petsc_command_line));
-  core::info(comm, "[generate] estimate: about {} on disk and {} of CPU for the whole dataset (rough: ~{:.0f} nodes "
-             "per shape)", format_bytes(est.bytes), format_duration(est.cpu_seconds), est.nodes_per_shape);
+  core::info(comm, "[generate] estimate: {}", est.line());
   OutputState out;
   core::on_root(comm, [&] { out = open_output(cfg, opt, est, n_shards); });
   core::install_interrupt_handlers("generate", rank);

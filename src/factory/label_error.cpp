@@ -35,7 +35,7 @@ solver::ErrorEstimate LabelErrorEstimator::estimate(const config::DatasetConfig&
 
 LabelErrors::LabelErrors(const config::DatasetConfig& cfg, int n_loads)
     : enabled_(cfg.representations.error_estimate), rel_l2_(std::size_t(n_loads), 0.0),
-      max_u_(std::size_t(n_loads), 0.0), alpha_(std::size_t(n_loads), 0.0) {}
+      max_u_(std::size_t(n_loads), 0.0), alpha_(std::size_t(n_loads), 0.0), fine_states_(std::size_t(n_loads)) {}
 
 LabelErrorSummary LabelErrors::summary(const std::vector<std::int8_t>& status) const {
   LabelErrorSummary s;
@@ -94,12 +94,16 @@ void LabelErrors::estimate(MPI_Comm group, const config::DatasetConfig& cfg, con
   try {
     if (!estimator_) estimator_ = std::make_unique<LabelErrorEstimator>(group, cfg, shape, first, coarse);
     rel_l2_[L] = max_u_[L] = alpha_[L] = -1;  // no estimate (until it is formed)
-    const solver::ErrorEstimate e = estimator_->estimate(cfg, lc, u, alpha, coarse_solve);
+    solver::ErrorEstimate e = estimator_->estimate(cfg, lc, u, alpha, coarse_solve);
     if (e.inverted) rel_l2_[L] = max_u_[L] = alpha_[L] = inverted_label;
     if (!e.ok) return;
     rel_l2_[L] = e.rel_l2;
     max_u_[L] = e.max_u;
     alpha_[L] = e.alpha;
+    if (keep_fine_states_ && !e.fine_state.empty()) {
+      if (fine_coords_.empty()) fine_coords_ = estimator_->fine().space().canonical_coords();
+      fine_states_[L] = std::move(e.fine_state);
+    }
   } catch (const std::runtime_error& e) {  // PETSc's failures: the estimate stays 0
     core::info(group, "shape {} load {}: error estimate failed: {}", shape.shape_id, lc.load_id, e.what());
   }

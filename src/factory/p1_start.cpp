@@ -1,7 +1,5 @@
 #include "hypershape/factory/p1_start.hpp"
 
-#include <petscdm.h>
-
 #include <algorithm>
 #include <array>
 #include <stdexcept>
@@ -42,26 +40,8 @@ std::vector<double> p2_values(const physics::Space& s2, const std::vector<double
 core::VecH prolong_p1_to_p2(const physics::Problem& p1, Vec u1, const physics::Problem& p2) {
   const physics::Space& s2 = p2.space();
   if (p1.space().degree() != 1 || s2.degree() != 2) throw std::logic_error("prolong_p1_to_p2: P1 to P2 only");
-  const MPI_Comm comm = p2.comm();
   const physics::NodalField f1 = p1.gather(u1);
-  std::vector<double> v = core::rank(comm) == 0 ? p2_values(s2, f1.values) : std::vector<double>{};
-  unsigned long n = v.size();
-  MPI_Bcast(&n, 1, MPI_UNSIGNED_LONG, 0, comm);
-  v.resize(n);
-  MPI_Bcast(v.data(), int(n), MPI_DOUBLE, 0, comm);
-  const int d = s2.dim();
-  Vec ul;
-  HS_PETSC(DMGetLocalVector(p2.dm(), &ul));
-  HS_PETSC(VecZeroEntries(ul));
-  PetscScalar* a;
-  HS_PETSC(VecGetArray(ul, &a));
-  for (const auto& node : s2.owned_nodes())
-    for (int k = 0; k < d; ++k) a[node.offset + k] = v[std::size_t(node.canonical * d + k)];
-  HS_PETSC(VecRestoreArray(ul, &a));
-  core::VecH u2 = p2.create_vector();
-  HS_PETSC(DMLocalToGlobal(p2.dm(), ul, INSERT_VALUES, u2));  // the owned nodes; constrained dofs drop out
-  HS_PETSC(DMRestoreLocalVector(p2.dm(), &ul));
-  return u2;
+  return p2.scatter(core::rank(p2.comm()) == 0 ? p2_values(s2, f1.values) : std::vector<double>{});
 }
 
 bool P1Start::applies(const solver::TargetResult& failed) const {
@@ -86,12 +66,11 @@ std::optional<solver::TargetResult> P1Start::solve(const LoadCase& lc, solver::N
   }
   const core::VecH start = prolong_p1_to_p2(*sp_.problem, nl_->solution(), p2.problem());
   solver::TargetResult t = p2.solve_for_target_from(start, p1.alpha, lc.target);
-  t.add_earlier(failed, true);
+  t.add_discarded_solve(failed);
   t.newton_iterations += p1.newton_iterations;  // P1's, discarded work too (each a quarter of a P2 one's cost)
   t.recovery_iterations += p1.newton_iterations;
-  t.linear += failed.linear;  // (add_earlier counts iterations; the factorisations of all three solves)
-  t.linear += p1.linear;
-  t.seconds_total += failed.seconds_total + p1.seconds_total;
+  t.linear += p1.linear;  // the factorisations of all three solves
+  t.seconds_total += p1.seconds_total;
   t.reason = t.converged ? "target reached from the P1 solution on the same mesh (" + t.reason.substr(0, 200) +
                                "; first try: " + failed.reason.substr(0, 300) + ")"
                          : failed.reason.substr(0, 400) + "; from the P1 solution on the same mesh: " +

@@ -29,21 +29,37 @@ double pilot_vertices(const config::DatasetConfig& cfg, const std::optional<geom
   }
 }
 
+/// Rough CPU seconds of one typical load case on `nodes` nodes of degree `degree` (its error
+/// estimate included when `estimate`). Measured per load case (the phases of
+/// `scripts/bench_generate.sh`, 1 rank, 2026-11-28): 2D P1 5.3k unknowns 0.034-0.044 s, 2D P2
+/// 13.5k unknowns 0.15-0.22 s (random2d_p1, random2d; two seeds); 3D P2 3.3k unknowns 7 s; cost
+/// grows faster than the unknowns. The estimate costs about the solve again (the run reports'
+/// phases, 2026-12-02: error_estimate 77 s against 60 s of solve + alpha_search on Random2D 8 x 25,
+/// the whole EasyRandom2D run 1.9x the solve-only estimate).
+double cpu_seconds_per_load(int dim, int degree, double nodes, bool estimate) {
+  const double c = dim == 3 ? 1.9e-4 : degree == 1 ? 5.6e-7 : 7.9e-7;
+  return (0.005 + c * std::pow(nodes * dim, 1.3)) * (estimate ? 2.0 : 1.0);
+}
+
 }  // namespace
 
 DatasetEstimate estimate_dataset(const config::DatasetConfig& cfg, const std::optional<geometry::Boundary>& base) {
   // 3D: a shape fills about 2.5 of the box's 8; vertices of a tetrahedral mesh of size h: 1.5 / h^3
   // per volume. 2D: shape 0's mesh (without a draw: 2.5 of the box's 4, 1.15 / h^2 per area).
   // P2 adds edge nodes (x4 in 2D, x8 in 3D); a uniform refinement multiplies the vertices by 4 / 8.
-  // A dataset asked for by accuracy: at its ladder's level 1 (a shape is stored at its finest
-  // label's level, known only once it is solved; Random2D at rel_l2 0.01 stored 5 of 8 shapes at
-  // level 2, 4x these sizes, and 3 at level 1 (2026-12-02, session 68): docs/ACCURACY.md).
   const int d = cfg.shapes.dim;
-  const AccuracyLevel level = accuracy_level(cfg, cfg.accuracy.enabled() ? std::min(1, cfg.accuracy.max_level) : 0);
-  const double h = level.h;
-  const double pilot = d == 2 ? pilot_vertices(cfg, base) * std::pow(4.0, level.refinements) : 0.0;
-  const double vertices = pilot > 0 ? pilot : d == 2 ? 2.5 * 1.15 / (h * h) : 2.5 * 1.5 / (h * h * h);
-  const double n = vertices * (level.degree == 1 ? 1.0 : (d == 2 ? 4.0 : 8.0));
+  const double pilot = d == 2 ? pilot_vertices(cfg, base) : 0.0;
+  auto nodes_at = [&](int k) {  // nodes of a shape at the ladder's level k (0: the config's own mesh)
+    const AccuracyLevel level = accuracy_level(cfg, k);
+    const double vertices = pilot > 0  ? pilot * std::pow(4.0, level.refinements)
+                            : d == 2   ? 2.5 * 1.15 / (level.h * level.h)
+                                       : 2.5 * 1.5 / (level.h * level.h * level.h);
+    return std::pair{vertices, vertices * (level.degree == 1 ? 1.0 : (d == 2 ? 4.0 : 8.0))};
+  };
+  // A dataset asked for by accuracy is sized at its ladder's level 1 (a shape is stored at its
+  // finest label's level, known only once it is solved; Random2D at rel_l2 0.01 stored 5 of 8
+  // shapes at level 2, 4x these sizes, and 3 at level 1 (2026-12-02, session 68): docs/ACCURACY.md).
+  const auto [vertices, n] = nodes_at(cfg.accuracy.enabled() ? std::min(1, cfg.accuracy.max_level) : 0);
   const double grid = cfg.representations.grid ? std::pow(double(cfg.representations.grid_size), d) : 0.0;
   const double pc = cfg.representations.point_cloud ? 1.0 : 0.0;
   const double per_shape = n * d * 8 + vertices * (d + 1) * 2 * 8 + n * 2 + pc * n * 16 + grid * 9;
@@ -54,16 +70,29 @@ DatasetEstimate estimate_dataset(const config::DatasetConfig& cfg, const std::op
   // noisy floats. Measured: random2d 1 shape x 50 load cases 16 MB estimated / 10.8 MB written;
   // a 2D slice at h 0.1 with 64^2 grids 2.0 / 2.9 MB; random3d 1 x 4 28 / 16 MB.
   e.bytes_per_shape = per_shape + cfg.loads.count * per_load + 50e3;
-  // Measured per load case (the phases of `scripts/bench_generate.sh`, 1 rank, 2026-11-28): 2D P1
-  // 5.3k unknowns 0.034-0.044 s, 2D P2 13.5k unknowns 0.15-0.22 s (random2d_p1, random2d; two
-  // seeds); 3D P2 3.3k unknowns 7 s; cost grows faster than the unknowns.
-  const double dofs = n * d;
-  const double c = d == 3 ? 1.9e-4 : level.degree == 1 ? 5.6e-7 : 7.9e-7;
-  // A shape costs its draw and mesh too (~0.2 s in 2D, ~5 s in 3D at the presets' sizes).
-  e.cpu_seconds_per_load = 0.005 + c * std::pow(dofs, 1.3);
+  // Every load case is solved at level 0; what the labels that climb cost on top is known only as
+  // they are solved: per level, a typical load case's cost there (a label that climbs is a hard
+  // one: Random2D's took several times that, docs/ACCURACY.md).
+  const bool estimate = cfg.representations.error_estimate;
+  e.cpu_seconds_per_load = cpu_seconds_per_load(d, cfg.degree, nodes_at(0).second, estimate);
+  for (int k = 1; cfg.accuracy.enabled() && k <= cfg.accuracy.max_level; ++k)
+    e.cpu_seconds_per_resolve.push_back(cpu_seconds_per_load(d, accuracy_level(cfg, k).degree, nodes_at(k).second, true));
   e.bytes = e.bytes_per_shape * double(cfg.n_shapes);
+  // A shape costs its draw and mesh too (~0.2 s in 2D, ~5 s in 3D at the presets' sizes).
   e.cpu_seconds = (e.cpu_seconds_per_load * cfg.loads.count + (d == 2 ? 0.2 : 5.0)) * double(cfg.n_shapes);
   return e;
+}
+
+std::string DatasetEstimate::line() const {
+  const bool ladder = !cpu_seconds_per_resolve.empty();
+  std::string s = fmt::format("about {} on disk and {} of CPU for the whole dataset{} (rough: ~{:.0f} nodes per shape)",
+                              format_bytes(bytes), format_duration(cpu_seconds),
+                              ladder ? " if every label meets the bound at level 0" : "", nodes_per_shape);
+  if (!ladder) return s;
+  s += "; each label solved again adds about";
+  for (std::size_t k = 0; k < cpu_seconds_per_resolve.size(); ++k)
+    s += fmt::format("{} {:.2g} s at level {}", k ? "," : "", cpu_seconds_per_resolve[k], k + 1);
+  return s + " (a typical load case's; how many climb shows only as they are solved)";
 }
 
 std::string format_bytes(double b) {

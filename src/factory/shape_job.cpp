@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <memory>
 #include <numeric>
+#include <optional>
 
 #include "hypershape/core/error.hpp"
 #include "hypershape/core/log.hpp"
@@ -409,9 +411,35 @@ struct LoadOutcome {
   physics::NodalField u;
 };
 
+/// A start for a load case's solve other than rest: a coarser level's label (u, alpha) carried to
+/// this level's mesh, the same function (the levels are nested).
+struct WarmStart {
+  core::VecH u;
+  double alpha = 0;
+  int level = 0;  ///< the level the label was solved at
+};
+
+/// The load case's target solve: from rest or, given `warm`, from there (and from rest where that
+/// fails; the failed try counted as discarded work).
+solver::TargetResult solve_target(solver::NonlinearSolver& nl, const LoadCase& lc, const WarmStart* warm) {
+  nl.reset();
+  if (!warm) return nl.solve_for_target(lc.target);
+  solver::TargetResult t = nl.solve_for_target_from(warm->u, warm->alpha, lc.target);
+  if (t.converged) {
+    t.reason = fmt::format("from the level-{} label: {}", warm->level, t.reason);
+    return t;
+  }
+  const solver::TargetResult first = t;
+  nl.reset();
+  t = nl.solve_for_target(lc.target);
+  t.add_discarded_solve(first);
+  t.reason = fmt::format("{} (from rest; from the level-{} label: {})", t.reason, warm->level, first.reason.substr(0, 300));
+  return t;
+}
+
 LoadOutcome solve_load_case(MPI_Comm group, const config::DatasetConfig& cfg, const ShapeSample& shape,
                             ShapeProblem& sp, solver::NonlinearSolver& nl, P1Start& p1, const LoadCase& lc,
-                            core::PhaseTimes& times, double& normaliser) {
+                            const WarmStart* warm, core::PhaseTimes& times, double& normaliser) {
   LoadOutcome o;
   std::string failure;
   try {
@@ -420,8 +448,7 @@ LoadOutcome solve_load_case(MPI_Comm group, const config::DatasetConfig& cfg, co
       sp.set_load_case(cfg, shape, lc);
     }
     normaliser = first_normaliser(*sp.problem);
-    nl.reset();
-    o.result = nl.solve_for_target(lc.target);
+    o.result = solve_target(nl, lc, warm);
     times.add("solve", o.result.seconds_first_solve);
     times.add("alpha_search", o.result.seconds_total - o.result.seconds_first_solve);
     if (p1.applies(o.result)) {
@@ -475,10 +502,14 @@ struct Level {
   std::vector<char> solved;                    ///< 1: the load case was solved here
 };
 
-/// Solves the load cases `which` of `lv` (the solver set up once for them all) and records them in
-/// `lv`; their solver work goes to out.counters, `on_load(converged)` runs after each. Collective.
+/// A load case's start other than rest, if any (WarmStart); collective.
+using WarmStarts = std::function<std::optional<WarmStart>(int load)>;
+
+/// Solves the load cases `which` of `lv` (the solver set up once for them all; each from rest or
+/// from `warm`'s start, if given) and records them in `lv`; their solver work goes to
+/// out.counters, `on_load(converged)` runs after each. Collective.
 void solve_loads(MPI_Comm group, Level& lv, const std::vector<LoadCase>& cases, const std::vector<int>& which,
-                 const std::function<void(bool)>& on_load, ShapeJobResult& out) {
+                 const WarmStarts& warm, const std::function<void(bool)>& on_load, ShapeJobResult& out) {
   std::unique_ptr<solver::NonlinearSolver> nl;
   {
     auto t = out.times.scope("setup");
@@ -489,7 +520,9 @@ void solve_loads(MPI_Comm group, Level& lv, const std::vector<LoadCase>& cases, 
     const auto L = std::size_t(l);
     lv.table.set_case(L, cases[L]);
     lv.solved[L] = 1;
-    LoadOutcome o = solve_load_case(group, lv.cfg, lv.shape, lv.sp, *nl, p1, cases[L], out.times, lv.table.normaliser[L]);
+    const std::optional<WarmStart> start = warm ? warm(l) : std::nullopt;
+    LoadOutcome o = solve_load_case(group, lv.cfg, lv.shape, lv.sp, *nl, p1, cases[L], start ? &*start : nullptr,
+                                    out.times, lv.table.normaliser[L]);
     lv.table.set_cost(L, o.result);
     lv.factorizations[L] = o.result.linear.numeric_factorizations;
     out.counters.add(o.result);
@@ -635,6 +668,52 @@ void summarise_accuracy(const config::DatasetConfig& cfg, const std::vector<std:
   out.entry.arrays.push_back(schema_array("loads/accuracy_tried", {n}, std::vector<std::int8_t>(tried.begin(), tried.end())));
 }
 
+/// The starts of level k's re-solves (`accuracy: {start: coarse}`): where level k is the mesh of the
+/// label a load case would replace refined once (the same degree), the state that label's error
+/// estimate reached on that mesh (P u_h + e: the fine Newton's state at the label's alpha, which
+/// has already relaxed what P u_h over-stretches next to the clamp's ends), at that alpha. Not
+/// otherwise: measured on Random2D (2026-12-02), the label itself carried to a finer mesh is no
+/// equilibrium there (its first increments creep, 37-149 Newton iterations against 26-110 from
+/// rest), and a P1 label carried to P2 on its own mesh is a locked state far from P2's (3x the
+/// factorisations of the re-solves from rest on the P1 test config). Group root; the node
+/// permutation of each coarser level built at its first use.
+WarmStarts estimates_reached(MPI_Comm group, const config::DatasetConfig& cfg,
+                             const std::vector<std::unique_ptr<Level>>& levels, int k, const LoadLadder& ladder) {
+  auto permutations = std::make_shared<std::map<int, std::vector<std::int64_t>>>();
+  return [group, &cfg, &levels, k, &ladder, permutations](int l) -> std::optional<WarmStart> {
+    const auto L = std::size_t(l);
+    const int had = ladder.kept(l), d = cfg.shapes.dim;
+    const Level& from = *levels[std::size_t(had)];
+    const Level& to = *levels[std::size_t(k)];
+    const AccuracyLevel a = accuracy_level(cfg, had), b = accuracy_level(cfg, k);
+    if (!from.table.status[L] || from.errors.rel_l2()[L] < 0 || a.degree != b.degree ||
+        b.refinements != a.refinements + 1)
+      return std::nullopt;
+    std::vector<double> u;
+    bool found = true;
+    if (core::rank(group) == 0) {
+      auto it = permutations->find(had);
+      if (it == permutations->end()) {
+        it = permutations->emplace(had, node_permutation(from.errors.fine_coords(), to.sp.problem->space().canonical_coords(), d)).first;
+        if (it->second.empty())  // not expected: both are the same mesh refined once
+          core::info(group, "shape {}: the estimate's refined nodes differ from level {}'s: its re-solves start from rest",
+                     from.shape.shape_id, k);
+      }
+      const auto& p = it->second;
+      const std::vector<double>& fine = from.errors.fine_state(L);
+      found = !p.empty() && fine.size() == p.size() * std::size_t(d);
+      if (found) {
+        u.resize(fine.size());
+        for (std::size_t j = 0; j < p.size(); ++j)
+          for (int c = 0; c < d; ++c) u[j * std::size_t(d) + std::size_t(c)] = fine[std::size_t(p[j]) * std::size_t(d) + std::size_t(c)];
+      }
+    }
+    MPI_Bcast(&found, 1, MPI_CXX_BOOL, 0, group);
+    if (!found) return std::nullopt;
+    return WarmStart{to.sp.problem->scatter(std::move(u)), from.table.alpha[L], had};
+  };
+}
+
 /// The accuracy ladder (factory/accuracy.hpp), load case by load case, on one drawn shape: the
 /// levels LoadLadder schedules, each set up once, when first needed, on the shape refined as often
 /// as it asks. The shape is stored on the finest level a label was kept at, the coarser labels
@@ -653,6 +732,8 @@ void solve_by_accuracy(MPI_Comm group, const config::DatasetConfig& cfg, const S
     config::DatasetConfig at = cfg;
     at.degree = a.degree;
     lv = std::make_unique<Level>(group, at, refined[std::size_t(a.refinements)], cases[0], out.times);
+    if (cfg.accuracy.start_from_coarse && k < cfg.accuracy.max_level && accuracy_level(cfg, k + 1).degree == a.degree)
+      lv->errors.keep_fine_states();  // the next level's starts (estimates_reached)
     return *lv;
   };
   LoadLadder ladder(cfg, n);
@@ -661,7 +742,8 @@ void solve_by_accuracy(MPI_Comm group, const config::DatasetConfig& cfg, const S
   for (int k = 0; k >= 0; k = ladder.next(todo)) {
     Level& lv = level(k);
     for (int l : todo) out.accuracy.fell_back += ladder.falls_back(l);
-    solve_loads(group, lv, cases, todo, k == 0 ? on_load : std::function<void(bool)>{}, out);
+    solve_loads(group, lv, cases, todo, k > 0 && cfg.accuracy.start_from_coarse ? estimates_reached(group, cfg, levels, k, ladder) : WarmStarts{},
+                k == 0 ? on_load : std::function<void(bool)>{}, out);
     for (int l : todo) {
       const auto L = std::size_t(l);
       const int had = ladder.kept(l);
@@ -703,7 +785,7 @@ ShapeJobResult run_shape(MPI_Comm group, const config::DatasetConfig& cfg,
   levels.push_back(std::make_unique<Level>(group, cfg, *shape, cases[0], out.times));
   std::vector<int> all(std::size_t(cfg.loads.count)), from(all.size(), 0);
   std::iota(all.begin(), all.end(), 0);
-  solve_loads(group, *levels[0], cases, all, on_load, out);
+  solve_loads(group, *levels[0], cases, all, {}, on_load, out);
   store_shape(group, levels, 0, from, cases, out);
   return out;
 }

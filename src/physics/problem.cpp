@@ -430,6 +430,24 @@ NodalField Problem::gather(Vec u) const {
   return out;
 }
 
+core::VecH Problem::scatter(std::vector<double> values) const {
+  unsigned long n = values.size();
+  MPI_Bcast(&n, 1, MPI_UNSIGNED_LONG, 0, comm());
+  values.resize(n);
+  MPI_Bcast(values.data(), int(n), MPI_DOUBLE, 0, comm());
+  const int d = space_->dim();
+  if (n != std::size_t(space_->n_nodes_global()) * std::size_t(d))
+    throw std::logic_error("Problem::scatter: the field's size differs from the mesh's nodes");
+  LocalArray ul(dm(), true);
+  PetscScalar* a = ul.array();
+  for (const auto& node : space_->owned_nodes())
+    for (int k = 0; k < d; ++k) a[node.offset + k] = values[std::size_t(node.canonical * d + k)];
+  core::VecH u = create_vector();
+  ul.release();
+  HS_PETSC(DMLocalToGlobal(dm(), ul.vec(), INSERT_VALUES, u));  // the owned nodes; constrained dofs drop out
+  return u;
+}
+
 core::MatH Problem::create_matrix() const {
   // The pattern once per problem (Space::create_matrix); a copy of it costs a memcpy.
   if (!pattern_) pattern_ = space_->create_matrix();

@@ -621,9 +621,14 @@ ErrorEstimate TwoLevelEstimator::estimate(Vec u_h, double alpha, const CoarseSol
   LogEvent values(events().estimate_values);
   const std::vector<double> uc = coarse_.gather(u_h).values, ev = fine_.gather(e).values, av = coarse_.gather(a).values;
   std::array<double, 6> vals{};  // rel L2, raw rel L2, max, raw max, slope, ok
-  if (core::rank(comm) == 0 && ok) vals = estimate_values(fs, prolong(uc), uc, ev, av, theta, alpha);
+  std::vector<double> pu;
+  if (core::rank(comm) == 0 && ok) pu = prolong(uc), vals = estimate_values(fs, pu, uc, ev, av, theta, alpha);
   MPI_Bcast(vals.data(), 6, MPI_DOUBLE, 0, comm);
   out.ok = vals[5] > 0.5;
+  if (out.ok && !pu.empty()) {
+    for (std::size_t i = 0; i < pu.size(); ++i) pu[i] += ev[i];
+    out.fine_state = std::move(pu);
+  }
   if (out.ok) {
     out.rel_l2 = vals[0], out.raw_rel_l2 = vals[1], out.max_u = vals[2], out.raw_max_u = vals[3];
     out.slope = vals[4];

@@ -4,7 +4,8 @@
 # own mesh cannot meet climbs the ladder (P1 -> P2 -> P2 on the mesh refined) until its estimate
 # meets it, each label's level recorded (loads/accuracy_level), the shape stored on its finest
 # label's level (attributes accuracy_*) with the coarser labels carried to that mesh exactly; a
-# loose bound keeps level 0, whose arrays are those of the same config without the key.
+# loose bound keeps level 0, whose arrays are those of the same config without the key; a re-solve
+# starts from the label it would replace (`start: coarse`) and reaches the labels of `start: rest`.
 # Needs HYPERSHAPE_BIN and HYPERSHAPE_SOURCE_DIR (set by CTest).
 . "$(dirname "$0")/lib.sh"
 
@@ -34,6 +35,7 @@ refuse '{rel_l2: tight}' 'accuracy.rel_l2'
 refuse '{rel_l2: 0.01, max_levle: 2}' 'accuracy.max_levle'
 refuse '{max_level: 2}' 'accuracy.rel_l2'
 refuse '{rel_l2: 0.01, max_level: 9}' 'accuracy.max_level'
+refuse '{rel_l2: 0.01, start: coarsest}' 'accuracy.start'
 
 # check.py DIR BOUND MIN_LEVEL [MAX_LEVEL]: every label's level recorded, >= MIN_LEVEL, the shape
 # stored on the finest; its estimate meets BOUND or is counted in accuracy_exceeding, allowed below
@@ -106,6 +108,44 @@ for f in sorted(glob.glob(f"{sys.argv[1]}/shards/*.h5")):
             assert dm.sum() > 0 and nm.sum() > 0 and (g["loads/status"][...] == 1).any()
 assert n1 > 0, "no shape at level 1"
 PY
+
+# A re-solve on the label's mesh refined once starts from the state the label's estimate reached
+# there (`start: coarse`, the default): the same labels as from rest (`start: rest`) to the
+# solver's tolerance, for fewer factorisations; each such label's reason says where it started.
+printf '%s\nmesh: {degree: 2}\naccuracy: {rel_l2: 0.02, max_level: 1, start: rest}\n' "$base" > "$work/refine_rest.yaml"
+"$bin" -q generate "$work/refine_rest.yaml" --progress 0 -o "$work/refine_rest" > /dev/null 2>&1 || fail "generate (refined, start: rest)"
+/usr/bin/python3 - "$work/refine" "$work/refine_rest" <<'PY' && ok "start: coarse: the labels of start: rest (alpha to 1e-6, u to 1e-5 of max|u|), fewer factorisations" \
+  || fail "start: coarse against start: rest"
+import glob, h5py, json, sys
+def shapes(d):
+    out = {}
+    for f in sorted(glob.glob(f"{d}/shards/*.h5")):
+        h = h5py.File(f)
+        out.update({sid: g for sid, g in h["shapes"].items()})
+    return out
+def counts(d):
+    return json.load(open(glob.glob(f"{d}/reports/*.json")[0]))["solver"]["numeric_factorizations"]
+coarse, rest = shapes(sys.argv[1]), shapes(sys.argv[2])
+warm = 0
+for sid, g in coarse.items():
+    r = rest[sid]
+    lv, st = g["loads/accuracy_level"][...], g["loads/status"][...]
+    assert (lv == r["loads/accuracy_level"][...]).all() and (st == r["loads/status"][...]).all(), sid
+    reasons = [x.decode() if isinstance(x, bytes) else x for x in g["loads/reason"][...]]
+    for L in range(len(lv)):
+        if not st[L] or lv[L] == 0: continue
+        warm += reasons[L].startswith("from the level-0 label")
+        a, b = g["loads/alpha"][L], r["loads/alpha"][L]
+        assert abs(a - b) <= 1e-6 * abs(b), (sid, L, a, b)
+        u, v = g["loads/displacement"][L], r["loads/displacement"][L]
+        assert abs(u - v).max() <= 1e-5 * abs(v).max(), (sid, L, abs(u - v).max())
+assert warm > 0, "no label started from the coarser one"
+assert counts(sys.argv[1]) < counts(sys.argv[2]), (counts(sys.argv[1]), counts(sys.argv[2]))
+print("labels started from level 0:", warm, "factorisations", counts(sys.argv[1]), "against", counts(sys.argv[2]))
+PY
+mpiexec -n 2 "$bin" -q generate "$work/refine.yaml" --progress 0 -o "$work/refine_np2" > /dev/null 2>&1 || fail "2-rank run (refined)"
+compare "$work/refine" "$work/refine_np2" > "$work/cmp.txt" && ok "labels started from the estimate's state: 2 ranks make the same dataset bit for bit" \
+  || { head -20 "$work/cmp.txt"; fail "2 ranks differ from 1 (refined)"; }
 
 # A loose bound keeps level 0: the arrays are those of the config without the key (estimates on).
 printf '%s\naccuracy: {rel_l2: 0.9}\n' "$base" > "$work/loose.yaml"

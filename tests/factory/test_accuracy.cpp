@@ -16,6 +16,7 @@
 #include "hypershape/factory/accuracy.hpp"
 #include "hypershape/factory/dataset_scene.hpp"
 #include "hypershape/geometry/surface_remesh.hpp"
+#include "hypershape/mesh/refine.hpp"
 
 using namespace hypershape;
 
@@ -85,6 +86,14 @@ TEST_CASE("accuracy: is parsed, validated, implies the estimate and joins the id
   CHECK(config::canonical_text(acc) != config::canonical_text(plain));
   CHECK(config::canonical_text(config::parse_dataset_text(head + "accuracy: {rel_l2: 0.003}\n", "<test>")) !=
         config::canonical_text(acc));
+  // start: coarse (the default) or rest; the two are different datasets.
+  CHECK(acc.accuracy.start_from_coarse);
+  const auto rest = config::parse_dataset_text(head + "accuracy: {rel_l2: 0.01, start: rest}\n", "<test>");
+  CHECK(!rest.accuracy.start_from_coarse);
+  CHECK(config::canonical_text(rest) != config::canonical_text(acc));
+  CHECK(config::canonical_text(config::parse_dataset_text(head + "accuracy: {rel_l2: 0.01, start: coarse}\n", "<test>")) ==
+        config::canonical_text(acc));
+  CHECK_THAT(message(head + "accuracy: {rel_l2: 0.01, start: fine}\n"), Catch::Contains("accuracy.start"));
   CHECK_THAT(message(head + "accuracy: {rel_l2: 0}\n"), Catch::Contains("accuracy.rel_l2"));
   CHECK_THAT(message(head + "accuracy: {rel_l2: 1}\n"), Catch::Contains("accuracy.rel_l2"));
   CHECK_THAT(message(head + "accuracy: {rel_l2: 0.01, bound: 2}\n"), Catch::Contains("accuracy.bound"));
@@ -303,6 +312,27 @@ TEST_CASE("refine_shape keeps the shape, its patch and the boundary-first number
   const auto rr = factory::refine_shape(r);
   check_boundary_on_mesh(rr);
   CHECK(rr.dirichlet_facets.size() == 4 * s.dirichlet_facets.size());
+}
+
+TEST_CASE("node_permutation matches the refined mesh's nodes in refine_shape's numbering, bit for bit", "[factory][accuracy]") {
+  // The estimator refines the shape's mesh with mesh::refine_uniform; the ladder's next level is
+  // refine_shape's (the same mesh, boundary first): a fine state of the one starts the other.
+  const auto c = config::parse_dataset_text(head, "<test>");
+  const auto s = factory::make_shape(factory::shape_config(c, 1), std::nullopt, c.seed, 1);
+  const auto u = mesh::refine_uniform(s.mesh).mesh;
+  const auto r = factory::refine_shape(s).mesh;
+  const auto p = factory::node_permutation(u.coords, r.coords, 2);
+  REQUIRE(p.size() == std::size_t(r.n_vertices()));
+  CHECK(std::set<std::int64_t>(p.begin(), p.end()).size() == p.size());
+  for (std::size_t j = 0; j < p.size(); ++j)
+    for (std::size_t k = 0; k < 2; ++k) CHECK(r.coords[j * 2 + k] == u.coords[std::size_t(p[j]) * 2 + k]);
+  bool renumbered = false;  // refine_shape numbers the boundary first: not the identity
+  for (std::size_t j = 0; j < p.size(); ++j) renumbered = renumbered || p[j] != std::int64_t(j);
+  CHECK(renumbered);
+  auto moved = r.coords;
+  moved[7] = std::nextafter(moved[7], 1e9);  // one node off by one ulp: not the same node set
+  CHECK(factory::node_permutation(u.coords, moved, 2).empty());
+  CHECK(factory::node_permutation(u.coords, std::vector<double>(r.coords.begin(), r.coords.end() - 2), 2).empty());
 }
 
 TEST_CASE("refine_shape on a tetrahedron: outward facets split in four", "[factory][accuracy]") {

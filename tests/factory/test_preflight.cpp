@@ -44,3 +44,32 @@ TEST_CASE("2D estimate of the Random2D presets' CPU time: within 2x of the facto
     CHECK(e.cpu_seconds / 3600 < core_hours * 2);
   }
 }
+
+TEST_CASE("2D estimate with error estimates and by accuracy: the estimate's cost, and what a climb adds per level",
+          "[factory][preflight]") {
+  // Measured 2026-12-02 (session 68's runs, 1 core, 8 x 25 load cases of seed 4242, CPU from
+  // /usr/bin/time): the random2d preset with estimates 94 s, easy_random2d with estimates 28.6 s;
+  // the estimate phase costs about the solve again (77 s against 60 s of solve + alpha_search).
+  for (const auto& [preset, seconds] : {std::pair<std::string, double>{"random2d", 94}, {"easy_random2d", 28.6}}) {
+    CAPTURE(preset);
+    const std::string text = "preset: " + preset + "\nseed: 4242\nshapes: {count: 8}\nloads: {count: 25}\n";
+    const auto plain = factory::estimate_dataset(config::parse_dataset_text(text, "<test>"), std::nullopt);
+    const auto with = factory::estimate_dataset(
+        config::parse_dataset_text(text + "representations: {error_estimate: true}\n", "<test>"), std::nullopt);
+    CHECK(with.cpu_seconds > 1.5 * plain.cpu_seconds);
+    CHECK(with.cpu_seconds > seconds / 1.5);
+    CHECK(with.cpu_seconds < seconds * 1.5);
+    CHECK(with.cpu_seconds_per_resolve.empty());
+    CHECK(with.line().find("solved again") == std::string::npos);
+    // By accuracy: the level-0 cost (with estimates), and per level what a label solved again adds,
+    // growing with the level's nodes; the printed line says both.
+    const auto acc = factory::estimate_dataset(
+        config::parse_dataset_text(text + "accuracy: {rel_l2: 0.01}\n", "<test>"), std::nullopt);
+    CHECK(acc.cpu_seconds == Approx(with.cpu_seconds));
+    REQUIRE(acc.cpu_seconds_per_resolve.size() == 2);
+    CHECK(acc.cpu_seconds_per_resolve[0] > acc.cpu_seconds_per_load);
+    CHECK(acc.cpu_seconds_per_resolve[1] > 4 * acc.cpu_seconds_per_resolve[0]);
+    CHECK(acc.line().find("if every label meets the bound at level 0") != std::string::npos);
+    CHECK(acc.line().find("at level 2") != std::string::npos);
+  }
+}

@@ -48,6 +48,11 @@ struct AccuracyLevel {
 /// Level `level` of `cfg`'s ladder (not collective).
 AccuracyLevel accuracy_level(const config::DatasetConfig& cfg, int level);
 
+/// p with node j of `to` at node p[j] of `from` (coordinates n x dim, equal bit for bit: the same
+/// mesh numbered twice, e.g. the estimator's refined mesh and the next level's); empty if the two
+/// node sets differ.
+std::vector<std::int64_t> node_permutation(const std::vector<double>& from, const std::vector<double>& to, int dim);
+
 /// The predicted factor by which the estimate falls from level `from` to level `to`: 10 for P1 -> P2
 /// on the same mesh (measured 8-20: docs/ACCURACY.md, P1 h 0.04 against P2 h 0.08 on the accuracy
 /// study's scenes, at error order ~1), 2 per uniform refinement (the order 1 the estimate assumes).

@@ -76,6 +76,12 @@ class LabelErrors {
   void take(std::size_t L, const LabelErrors& o);
   /// Frees the estimator (its refined problem); the estimates stay.
   void release_estimator() { estimator_.reset(); }
+  /// From now on, keeps each estimate's fine state (ErrorEstimate::fine_state) and the refined
+  /// mesh's node coordinates (group root): a start for the labels on that mesh.
+  void keep_fine_states() { keep_fine_states_ = true; }
+  /// Load case L's fine state (group root; empty where none was kept) and the nodes it lives on.
+  const std::vector<double>& fine_state(std::size_t L) const { return fine_states_[L]; }
+  const std::vector<double>& fine_coords() const { return fine_coords_; }
   /// Appends the three arrays (group root).
   void store(std::vector<io::Array>& arrays) const;
   bool enabled() const { return enabled_; }
@@ -88,6 +94,9 @@ class LabelErrors {
   bool enabled_ = true;
   std::unique_ptr<LabelErrorEstimator> estimator_;
   std::vector<double> rel_l2_, max_u_, alpha_;
+  bool keep_fine_states_ = false;
+  std::vector<std::vector<double>> fine_states_;  ///< group root: per load case, where kept
+  std::vector<double> fine_coords_;               ///< group root: the refined mesh's canonical node coordinates
 };
 
 }  // namespace hypershape::factory

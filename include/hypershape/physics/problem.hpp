@@ -132,6 +132,9 @@ class Problem {
   double min_det_f(Vec u) const;
   /// Gathers u on rank 0 in canonical node order (collective).
   NodalField gather(Vec u) const;
+  /// The inverse of gather: a global vector whose owned nodes take `values` (rank 0's, canonical
+  /// node order, n_nodes x dim; other ranks' ignored); constrained dofs drop out. Collective.
+  core::VecH scatter(std::vector<double> values) const;
   /// Matrix with the preallocated sparsity of the tangent (symmetric flag set if conservative()).
   core::MatH create_matrix() const;
   core::VecH create_vector() const;

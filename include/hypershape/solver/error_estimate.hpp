@@ -52,6 +52,9 @@ struct ErrorEstimate {
   int residual_assemblies = 0, tangent_assemblies = 0, factorizations = 0;
   double seconds = 0;
   double seconds_assembly = 0, seconds_linear = 0;  ///< parts of `seconds`: fine residuals and tangents; the fine solves
+  /// Rank 0, where formed: P u_h + e, the fine Newton's last state at alpha (canonical node order
+  /// of the fine space, n_nodes x dim): a start for the label on the refined mesh.
+  std::vector<double> fine_state;
 };
 
 /// The exact L2 norm squared of a P1/P2 nodal field (n_comp components, canonical node order)

@@ -211,6 +211,13 @@ struct TargetResult {
     increments += e.increments;
     recovery_iterations += discarded ? e.newton_iterations : e.recovery_iterations;
   }
+  /// add_earlier(e, true) for an attempt solved apart from this one (its own target solve, whose
+  /// linear counts and seconds this one's do not include): those are added too.
+  void add_discarded_solve(const TargetResult& e) {
+    add_earlier(e, true);
+    linear += e.linear;
+    seconds_total += e.seconds_total;
+  }
 };
 
 /// Puts config-file PETSc options (name with dash, value or "") into the options database,
