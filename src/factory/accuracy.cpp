@@ -77,7 +77,10 @@ bool LoadLadder::record(int L, int k, bool converged, double estimate) {
 
 int LoadLadder::climb(int L, int from, double e) const {
   if (!exceeds(cfg_.accuracy, e) || !curable(cfg_, from, e)) return -1;
-  for (int k = next_accuracy_level(cfg_, from, e); k <= cfg_.accuracy.max_level; ++k)
+  // start: coarse: one level at a time, so that each re-solve can start from the state the last
+  // label's estimate reached on its mesh refined (a jump starts from rest).
+  const int first = cfg_.accuracy.start_from_coarse ? from + 1 : next_accuracy_level(cfg_, from, e);
+  for (int k = first; k <= cfg_.accuracy.max_level; ++k)
     if (!tried(L, k)) return k;
   return -1;
 }

@@ -137,8 +137,9 @@ TEST_CASE("A label no level is predicted to bring under the bound does not climb
 
 TEST_CASE("The load-case ladder: who climbs, to which level, and the fall-back after a failed jump",
           "[factory][accuracy]") {
-  // P1 ladder to level 3; bound 0.01. Level 0 -> 1 is predicted 10x, -> 2 20x, -> 3 40x.
-  const auto c = config::parse_dataset_text(head + "accuracy: {rel_l2: 0.01, max_level: 3}\n", "<test>");
+  // P1 ladder to level 3; bound 0.01. Level 0 -> 1 is predicted 10x, -> 2 20x, -> 3 40x. Re-solves
+  // from rest (start: rest) jump to the lowest level predicted to meet the bound.
+  const auto c = config::parse_dataset_text(head + "accuracy: {rel_l2: 0.01, max_level: 3, start: rest}\n", "<test>");
   factory::LoadLadder ladder(c, 5);
   std::vector<int> loads;
   CHECK(ladder.record(0, 0, true, 0.005));  // meets the bound
@@ -178,7 +179,7 @@ TEST_CASE("The load-case ladder: who climbs, to which level, and the fall-back a
 
 TEST_CASE("The load-case ladder: a failed step to the next level ends the climb; the share allowed above stays",
           "[factory][accuracy]") {
-  const auto c = config::parse_dataset_text(head + "accuracy: {rel_l2: 0.01, max_level: 3}\n", "<test>");
+  const auto c = config::parse_dataset_text(head + "accuracy: {rel_l2: 0.01, max_level: 3, start: rest}\n", "<test>");
   factory::LoadLadder ladder(c, 2);
   std::vector<int> loads;
   ladder.record(0, 0, true, 0.05);
@@ -207,7 +208,7 @@ TEST_CASE("The load-case ladder: a failed step to the next level ends the climb;
 
 TEST_CASE("The load-case ladder: a converged re-solve not kept climbs on from its own estimate; a failed one stops",
           "[factory][accuracy]") {
-  const auto c = config::parse_dataset_text(head + "accuracy: {rel_l2: 0.01, max_level: 3}\n", "<test>");
+  const auto c = config::parse_dataset_text(head + "accuracy: {rel_l2: 0.01, max_level: 3, start: rest}\n", "<test>");
   factory::LoadLadder ladder(c, 3);
   std::vector<int> loads;
   for (int L = 0; L < 3; ++L) ladder.record(L, 0, true, 0.02);  // 0.02 / 10: all wait for level 1
@@ -227,6 +228,32 @@ TEST_CASE("The load-case ladder: a converged re-solve not kept climbs on from it
   CHECK(ladder.record(0, 3, true, 0.008));
   CHECK(ladder.next(loads) == -1);
   CHECK(ladder.kept_levels() == std::vector<int>{3, 2, 0});
+}
+
+TEST_CASE("The load-case ladder with start: coarse climbs one level at a time, each start warm", "[factory][accuracy]") {
+  // The same first records as the jump test above: the label predicted to need level 2 (0.15 / 20)
+  // goes to level 1 first; what the prediction still decides is whether a label climbs at all.
+  const auto c = config::parse_dataset_text(head + "accuracy: {rel_l2: 0.01, max_level: 3}\n", "<test>");
+  REQUIRE(c.accuracy.start_from_coarse);
+  factory::LoadLadder ladder(c, 3);
+  std::vector<int> loads;
+  ladder.record(0, 0, true, 0.05);
+  ladder.record(1, 0, true, 0.15);
+  ladder.record(2, 0, true, 0.5);  // incurable (0.5 / 40): no climb
+  CHECK(ladder.waiting(1) == 1);
+  CHECK(ladder.waiting(2) == -1);
+  REQUIRE(ladder.next(loads) == 1);
+  CHECK(loads == std::vector<int>{0, 1});
+  CHECK(ladder.record(0, 1, true, 0.008));
+  CHECK(ladder.record(1, 1, true, 0.03));   // kept, still above: one level up, not to 3 (0.03 / 4 would meet)
+  CHECK(ladder.waiting(1) == 2);
+  REQUIRE(ladder.next(loads) == 2);
+  CHECK(ladder.record(1, 2, true, 0.012));  // kept, above: on to 3
+  REQUIRE(ladder.next(loads) == 3);
+  CHECK_FALSE(ladder.record(1, 3, false, -1));  // failed: level 2's label stays; nothing skipped, no fall-back
+  CHECK_FALSE(ladder.falls_back(1));
+  CHECK(ladder.next(loads) == -1);
+  CHECK(ladder.kept_levels() == std::vector<int>{1, 2, 0});
 }
 
 TEST_CASE("grade_shape keeps the polygon and its patch and grades the mesh towards the clamp ends",
