@@ -465,8 +465,8 @@ void parse_accuracy(const YamlBlock& top, const std::string& source, DatasetConf
   if (a.has("start")) {
     const std::string start = a.text("start");
     if (start != "coarse" && start != "rest")
-      a.fail("start", "must be coarse (a re-solve on the label's mesh refined once starts from its estimate's fine "
-                      "state) or rest (every re-solve from rest)");
+      a.fail("start", "must be rest (every re-solve from rest, the default) or coarse (one level at a time, each "
+                      "re-solve from the state the level below's estimate reached)");
     acc.start_from_coarse = start == "coarse";
   }
   a.allowed("rel_l2, max_level, exceed_share, start");

@@ -668,21 +668,23 @@ void summarise_accuracy(const config::DatasetConfig& cfg, const std::vector<std:
   out.entry.arrays.push_back(schema_array("loads/accuracy_tried", {n}, std::vector<std::int8_t>(tried.begin(), tried.end())));
 }
 
-/// The starts of level k's re-solves (`accuracy: {start: coarse}`): where level k is the mesh of the
-/// label a load case would replace refined once (the same degree), the state that label's error
-/// estimate reached on that mesh (P u_h + e: the fine Newton's state at the label's alpha, which
-/// has already relaxed what P u_h over-stretches next to the clamp's ends), at that alpha. Not
+/// The starts of level k's re-solves (`accuracy: {start: coarse}`): where the load case was solved
+/// on level k - 1 (its label kept or not) and level k is that mesh refined once (the same degree),
+/// the state that label's error estimate reached on level k's mesh (P u_h + e: the fine Newton's
+/// state at the label's alpha, which has already relaxed what P u_h over-stretches next to the
+/// clamp's ends), at that alpha. Not
 /// otherwise: measured on Random2D (2026-12-02), the label itself carried to a finer mesh is no
 /// equilibrium there (its first increments creep, 37-149 Newton iterations against 26-110 from
 /// rest), and a P1 label carried to P2 on its own mesh is a locked state far from P2's (3x the
 /// factorisations of the re-solves from rest on the P1 test config). Group root; the node
 /// permutation of each coarser level built at its first use.
 WarmStarts estimates_reached(MPI_Comm group, const config::DatasetConfig& cfg,
-                             const std::vector<std::unique_ptr<Level>>& levels, int k, const LoadLadder& ladder) {
+                             const std::vector<std::unique_ptr<Level>>& levels, int k) {
   auto permutations = std::make_shared<std::map<int, std::vector<std::int64_t>>>();
-  return [group, &cfg, &levels, k, &ladder, permutations](int l) -> std::optional<WarmStart> {
+  return [group, &cfg, &levels, k, permutations](int l) -> std::optional<WarmStart> {
     const auto L = std::size_t(l);
-    const int had = ladder.kept(l), d = cfg.shapes.dim;
+    const int had = k - 1, d = cfg.shapes.dim;  // the level below, if this load case was solved there (kept or not)
+    if (had < 0 || !levels[std::size_t(had)] || !levels[std::size_t(had)]->solved[L]) return std::nullopt;
     const Level& from = *levels[std::size_t(had)];
     const Level& to = *levels[std::size_t(k)];
     const AccuracyLevel a = accuracy_level(cfg, had), b = accuracy_level(cfg, k);
@@ -742,7 +744,7 @@ void solve_by_accuracy(MPI_Comm group, const config::DatasetConfig& cfg, const S
   for (int k = 0; k >= 0; k = ladder.next(todo)) {
     Level& lv = level(k);
     for (int l : todo) out.accuracy.fell_back += ladder.falls_back(l);
-    solve_loads(group, lv, cases, todo, k > 0 && cfg.accuracy.start_from_coarse ? estimates_reached(group, cfg, levels, k, ladder) : WarmStarts{},
+    solve_loads(group, lv, cases, todo, k > 0 && cfg.accuracy.start_from_coarse ? estimates_reached(group, cfg, levels, k) : WarmStarts{},
                 k == 0 ? on_load : std::function<void(bool)>{}, out);
     for (int l : todo) {
       const auto L = std::size_t(l);

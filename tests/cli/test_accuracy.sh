@@ -4,8 +4,8 @@
 # own mesh cannot meet climbs the ladder (P1 -> P2 -> P2 on the mesh refined) until its estimate
 # meets it, each label's level recorded (loads/accuracy_level), the shape stored on its finest
 # label's level (attributes accuracy_*) with the coarser labels carried to that mesh exactly; a
-# loose bound keeps level 0, whose arrays are those of the same config without the key; a re-solve
-# starts from the label it would replace (`start: coarse`) and reaches the labels of `start: rest`.
+# loose bound keeps level 0, whose arrays are those of the same config without the key; with
+# `start: coarse` a re-solve starts from the level below's estimate and reaches the same labels.
 # Needs HYPERSHAPE_BIN and HYPERSHAPE_SOURCE_DIR (set by CTest).
 . "$(dirname "$0")/lib.sh"
 
@@ -109,12 +109,12 @@ for f in sorted(glob.glob(f"{sys.argv[1]}/shards/*.h5")):
 assert n1 > 0, "no shape at level 1"
 PY
 
-# A re-solve on the label's mesh refined once starts from the state the label's estimate reached
-# there (`start: coarse`, the default): the same labels as from rest (`start: rest`) to the
-# solver's tolerance, for fewer factorisations; each such label's reason says where it started.
-printf '%s\nmesh: {degree: 2}\naccuracy: {rel_l2: 0.02, max_level: 1, start: rest}\n' "$base" > "$work/refine_rest.yaml"
-"$bin" -q generate "$work/refine_rest.yaml" --progress 0 -o "$work/refine_rest" > /dev/null 2>&1 || fail "generate (refined, start: rest)"
-/usr/bin/python3 - "$work/refine" "$work/refine_rest" <<'PY' && ok "start: coarse: the labels of start: rest (alpha to 1e-6, u to 1e-5 of max|u|), fewer factorisations" \
+# With `start: coarse` a re-solve on the mesh below refined once starts from the state the label's
+# estimate reached there: here the same labels as from rest (the default) to the solver's
+# tolerance, for fewer factorisations; each such label's reason says where it started.
+printf '%s\nmesh: {degree: 2}\naccuracy: {rel_l2: 0.02, max_level: 1, start: coarse}\n' "$base" > "$work/refine_coarse.yaml"
+"$bin" -q generate "$work/refine_coarse.yaml" --progress 0 -o "$work/refine_coarse" > /dev/null 2>&1 || fail "generate (refined, start: coarse)"
+/usr/bin/python3 - "$work/refine_coarse" "$work/refine" <<'PY' && ok "start: coarse: the labels of start: rest (alpha to 1e-6, u to 1e-5 of max|u|), fewer factorisations" \
   || fail "start: coarse against start: rest"
 import glob, h5py, json, sys
 def shapes(d):
@@ -143,8 +143,8 @@ assert warm > 0, "no label started from the coarser one"
 assert counts(sys.argv[1]) < counts(sys.argv[2]), (counts(sys.argv[1]), counts(sys.argv[2]))
 print("labels started from level 0:", warm, "factorisations", counts(sys.argv[1]), "against", counts(sys.argv[2]))
 PY
-mpiexec -n 2 "$bin" -q generate "$work/refine.yaml" --progress 0 -o "$work/refine_np2" > /dev/null 2>&1 || fail "2-rank run (refined)"
-compare "$work/refine" "$work/refine_np2" > "$work/cmp.txt" && ok "labels started from the estimate's state: 2 ranks make the same dataset bit for bit" \
+mpiexec -n 2 "$bin" -q generate "$work/refine_coarse.yaml" --progress 0 -o "$work/refine_np2" > /dev/null 2>&1 || fail "2-rank run (refined)"
+compare "$work/refine_coarse" "$work/refine_np2" > "$work/cmp.txt" && ok "labels started from the estimate's state: 2 ranks make the same dataset bit for bit" \
   || { head -20 "$work/cmp.txt"; fail "2 ranks differ from 1 (refined)"; }
 
 # A loose bound keeps level 0: the arrays are those of the config without the key (estimates on).

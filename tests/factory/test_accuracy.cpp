@@ -86,13 +86,14 @@ TEST_CASE("accuracy: is parsed, validated, implies the estimate and joins the id
   CHECK(config::canonical_text(acc) != config::canonical_text(plain));
   CHECK(config::canonical_text(config::parse_dataset_text(head + "accuracy: {rel_l2: 0.003}\n", "<test>")) !=
         config::canonical_text(acc));
-  // start: coarse (the default) or rest; the two are different datasets.
-  CHECK(acc.accuracy.start_from_coarse);
-  const auto rest = config::parse_dataset_text(head + "accuracy: {rel_l2: 0.01, start: rest}\n", "<test>");
-  CHECK(!rest.accuracy.start_from_coarse);
-  CHECK(config::canonical_text(rest) != config::canonical_text(acc));
-  CHECK(config::canonical_text(config::parse_dataset_text(head + "accuracy: {rel_l2: 0.01, start: coarse}\n", "<test>")) ==
+  // start: rest (the default; the identity as before the key) or coarse, a different dataset.
+  CHECK(!acc.accuracy.start_from_coarse);
+  const auto coarse = config::parse_dataset_text(head + "accuracy: {rel_l2: 0.01, start: coarse}\n", "<test>");
+  CHECK(coarse.accuracy.start_from_coarse);
+  CHECK(config::canonical_text(coarse) != config::canonical_text(acc));
+  CHECK(config::canonical_text(config::parse_dataset_text(head + "accuracy: {rel_l2: 0.01, start: rest}\n", "<test>")) ==
         config::canonical_text(acc));
+  CHECK_THAT(config::canonical_text(acc), Catch::Contains("accuracy: [0.01, 2, 0]\n"));
   CHECK_THAT(message(head + "accuracy: {rel_l2: 0.01, start: fine}\n"), Catch::Contains("accuracy.start"));
   CHECK_THAT(message(head + "accuracy: {rel_l2: 0}\n"), Catch::Contains("accuracy.rel_l2"));
   CHECK_THAT(message(head + "accuracy: {rel_l2: 1}\n"), Catch::Contains("accuracy.rel_l2"));
@@ -233,7 +234,7 @@ TEST_CASE("The load-case ladder: a converged re-solve not kept climbs on from it
 TEST_CASE("The load-case ladder with start: coarse climbs one level at a time, each start warm", "[factory][accuracy]") {
   // The same first records as the jump test above: the label predicted to need level 2 (0.15 / 20)
   // goes to level 1 first; what the prediction still decides is whether a label climbs at all.
-  const auto c = config::parse_dataset_text(head + "accuracy: {rel_l2: 0.01, max_level: 3}\n", "<test>");
+  const auto c = config::parse_dataset_text(head + "accuracy: {rel_l2: 0.01, max_level: 3, start: coarse}\n", "<test>");
   REQUIRE(c.accuracy.start_from_coarse);
   factory::LoadLadder ladder(c, 3);
   std::vector<int> loads;

@@ -98,10 +98,11 @@ struct AccuracyConfig {
   double rel_l2 = 0.0;        ///< bound on each load case's estimated relative L2 error of u, in (0, 1)
   int max_level = 2;          ///< the finest level of the ladder (factory::accuracy_level), in [0, 3]
   double exceed_share = 0.0;  ///< share of a shape's load cases that may stay above the bound, in [0, 0.5]
-  /// `start: coarse` (the default): a re-solve on the mesh of the label it would replace refined
-  /// once starts from the state that label's error estimate reached there (from rest where that
-  /// fails); `rest`: every re-solve from rest.
-  bool start_from_coarse = true;
+  /// `start: rest` (the default): every re-solve from rest, jumping to the lowest level predicted
+  /// to meet the bound. `coarse`: a label climbs one level at a time, and each re-solve starts
+  /// from the state the level below's error estimate reached on its mesh (from rest where that
+  /// fails): docs/ACCURACY.md, "A re-solve that starts where the estimate ended".
+  bool start_from_coarse = false;
   bool enabled() const { return rel_l2 > 0; }
 };
 
