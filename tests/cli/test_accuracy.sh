@@ -37,6 +37,17 @@ refuse '{max_level: 2}' 'accuracy.rel_l2'
 refuse '{rel_l2: 0.01, max_level: 9}' 'accuracy.max_level'
 refuse '{rel_l2: 0.01, start: coarsest}' 'accuracy.start'
 
+# shapes.py: every shape group of a dataset's shards, by id (the checks below import it).
+cat > "$work/shapes.py" <<'PY'
+import glob, h5py
+def shapes(d):
+    out = {}
+    for f in sorted(glob.glob(f"{d}/shards/*.h5")):
+        h = h5py.File(f)
+        out.update({sid: g for sid, g in h["shapes"].items()})
+    return out
+PY
+
 # check.py DIR BOUND MIN_LEVEL [MAX_LEVEL]: every label's level recorded, >= MIN_LEVEL, the shape
 # stored on the finest; its estimate meets BOUND or is counted in accuracy_exceeding, allowed below
 # MAX_LEVEL (default 2) only where not even MAX_LEVEL is predicted to meet BOUND (P1 -> P2 / 10,
@@ -114,15 +125,10 @@ PY
 # tolerance, for fewer factorisations; each such label's reason says where it started.
 printf '%s\nmesh: {degree: 2}\naccuracy: {rel_l2: 0.02, max_level: 1, start: coarse}\n' "$base" > "$work/refine_coarse.yaml"
 "$bin" -q generate "$work/refine_coarse.yaml" --progress 0 -o "$work/refine_coarse" > /dev/null 2>&1 || fail "generate (refined, start: coarse)"
-/usr/bin/python3 - "$work/refine_coarse" "$work/refine" <<'PY' && ok "start: coarse: the labels of start: rest (alpha to 1e-6, u to 1e-5 of max|u|), fewer factorisations" \
+PYTHONPATH="$work" /usr/bin/python3 - "$work/refine_coarse" "$work/refine" <<'PY' && ok "start: coarse: the labels of start: rest (alpha to 1e-6, u to 1e-5 of max|u|), fewer factorisations" \
   || fail "start: coarse against start: rest"
 import glob, h5py, json, sys
-def shapes(d):
-    out = {}
-    for f in sorted(glob.glob(f"{d}/shards/*.h5")):
-        h = h5py.File(f)
-        out.update({sid: g for sid, g in h["shapes"].items()})
-    return out
+from shapes import shapes
 def counts(d):
     return json.load(open(glob.glob(f"{d}/reports/*.json")[0]))["solver"]["numeric_factorizations"]
 coarse, rest = shapes(sys.argv[1]), shapes(sys.argv[2])
@@ -197,16 +203,11 @@ printf '%s\naccuracy: {rel_l2: 0.16, max_level: 1}\n' "$base" > "$work/mixed.yam
 mpiexec -n 2 "$bin" -q generate "$work/mixed.yaml" --progress 0 -o "$work/mixed_np2" > /dev/null 2>&1 || fail "2-rank run (mixed)"
 compare "$work/mixed" "$work/mixed_np2" > "$work/cmp.txt" && ok "labels of two levels in a shape: 2 ranks make the same dataset bit for bit" \
   || { head -20 "$work/cmp.txt"; fail "2 ranks differ from 1 (mixed)"; }
-/usr/bin/python3 - "$work/mixed" "$work/plain" <<'PY' && ok "rel_l2 0.16: only the labels above it climb; those kept at level 0 carried to the P2 mesh exactly" \
+PYTHONPATH="$work" /usr/bin/python3 - "$work/mixed" "$work/plain" <<'PY' && ok "rel_l2 0.16: only the labels above it climb; those kept at level 0 carried to the P2 mesh exactly" \
   || fail "per-load-case levels"
 import glob, h5py, sys
 import numpy as np
-def shapes(d):
-    out = {}
-    for f in sorted(glob.glob(f"{d}/shards/*.h5")):
-        h = h5py.File(f)
-        out.update({sid: g for sid, g in h["shapes"].items()})
-    return out
+from shapes import shapes
 mixed, plain = shapes(sys.argv[1]), shapes(sys.argv[2])
 carried = 0
 for sid, g in mixed.items():
