@@ -411,12 +411,12 @@ struct LoadOutcome {
   physics::NodalField u;
 };
 
-/// A start for a load case's solve other than rest: a coarser level's label (u, alpha) carried to
-/// this level's mesh, the same function (the levels are nested).
+/// A start for a load case's solve other than rest: the state the error estimate of its label on a
+/// coarser level reached on this level's mesh, at that label's alpha.
 struct WarmStart {
   core::VecH u;
   double alpha = 0;
-  int level = 0;  ///< the level the label was solved at
+  int level = 0;  ///< the coarser level
 };
 
 /// The load case's target solve: from rest or, given `warm`, from there (and from rest where that
@@ -426,14 +426,14 @@ solver::TargetResult solve_target(solver::NonlinearSolver& nl, const LoadCase& l
   if (!warm) return nl.solve_for_target(lc.target);
   solver::TargetResult t = nl.solve_for_target_from(warm->u, warm->alpha, lc.target);
   if (t.converged) {
-    t.reason = fmt::format("from the level-{} label: {}", warm->level, t.reason);
+    t.reason = fmt::format("from the level-{} estimate: {}", warm->level, t.reason);
     return t;
   }
   const solver::TargetResult first = t;
   nl.reset();
   t = nl.solve_for_target(lc.target);
   t.add_discarded_solve(first);
-  t.reason = fmt::format("{} (from rest; from the level-{} label: {})", t.reason, warm->level, first.reason.substr(0, 300));
+  t.reason = fmt::format("{} (from rest; from the level-{} estimate: {})", t.reason, warm->level, first.reason.substr(0, 300));
   return t;
 }
 
@@ -672,9 +672,8 @@ void summarise_accuracy(const config::DatasetConfig& cfg, const std::vector<std:
 /// on level k - 1 (its label kept or not) and level k is that mesh refined once (the same degree),
 /// the state that label's error estimate reached on level k's mesh (P u_h + e: the fine Newton's
 /// state at the label's alpha, which has already relaxed what P u_h over-stretches next to the
-/// clamp's ends), at that alpha. Not
-/// otherwise: measured on Random2D (2026-12-02), the label itself carried to a finer mesh is no
-/// equilibrium there (its first increments creep, 37-149 Newton iterations against 26-110 from
+/// clamp's ends), at that alpha. Not otherwise: measured on Random2D (2026-12-02), the label itself
+/// carried to a finer mesh is no equilibrium there (its first increments creep, 37-149 Newton iterations against 26-110 from
 /// rest), and a P1 label carried to P2 on its own mesh is a locked state far from P2's (3x the
 /// factorisations of the re-solves from rest on the P1 test config). Group root; the node
 /// permutation of each coarser level built at its first use.

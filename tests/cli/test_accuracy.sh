@@ -140,12 +140,12 @@ for sid, g in coarse.items():
     reasons = [x.decode() if isinstance(x, bytes) else x for x in g["loads/reason"][...]]
     for L in range(len(lv)):
         if not st[L] or lv[L] == 0: continue
-        warm += reasons[L].startswith("from the level-0 label")
+        warm += reasons[L].startswith("from the level-0 estimate")
         a, b = g["loads/alpha"][L], r["loads/alpha"][L]
         assert abs(a - b) <= 1e-6 * abs(b), (sid, L, a, b)
         u, v = g["loads/displacement"][L], r["loads/displacement"][L]
         assert abs(u - v).max() <= 1e-5 * abs(v).max(), (sid, L, abs(u - v).max())
-assert warm > 0, "no label started from the coarser one"
+assert warm > 0, "no label started from the level below's estimate"
 assert counts(sys.argv[1]) < counts(sys.argv[2]), (counts(sys.argv[1]), counts(sys.argv[2]))
 print("labels started from level 0:", warm, "factorisations", counts(sys.argv[1]), "against", counts(sys.argv[2]))
 PY
