@@ -76,7 +76,9 @@ bool curable(const config::DatasetConfig& cfg, int current, double rel_l2);
 /// lowest level are solved there (next()), and each outcome is recorded (record()).
 ///
 /// A load case waits for the lowest level above its kept label's predicted to meet the bound
-/// (next_accuracy_level()), when its label misses it and is curable() and that level is untried.
+/// (next_accuracy_level()), when its label misses it and is curable() and that level is untried;
+/// with `accuracy: {start: coarse}`, for the next level up (one at a time, so that each re-solve
+/// can start from the state the level below's estimate reached: shape_job.cpp).
 /// A re-solve whose label is not kept (it failed, formed no estimate or estimated no lower):
 ///  - after a jump past levels it never tried, falls back to the highest of those (Random2D at
 ///    0.01, 2026-12-02: jumps from level 0 to 2 that failed there, of labels that met the bound at
