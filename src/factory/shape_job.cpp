@@ -676,11 +676,11 @@ void summarise_accuracy(const config::DatasetConfig& cfg, const std::vector<std:
 /// carried to a finer mesh is no equilibrium there (its first increments creep, 37-149 Newton iterations against 26-110 from
 /// rest), and a P1 label carried to P2 on its own mesh is a locked state far from P2's (3x the
 /// factorisations of the re-solves from rest on the P1 test config). Group root; the node
-/// permutation of each coarser level built at its first use.
+/// permutation from level k - 1's refined mesh built at its first use.
 WarmStarts estimates_reached(MPI_Comm group, const config::DatasetConfig& cfg,
                              const std::vector<std::unique_ptr<Level>>& levels, int k) {
-  auto permutations = std::make_shared<std::map<int, std::vector<std::int64_t>>>();
-  return [group, &cfg, &levels, k, permutations](int l) -> std::optional<WarmStart> {
+  auto permutation = std::make_shared<std::optional<std::vector<std::int64_t>>>();
+  return [group, &cfg, &levels, k, permutation](int l) -> std::optional<WarmStart> {
     const auto L = std::size_t(l);
     const int had = k - 1, d = cfg.shapes.dim;  // the level below, if this load case was solved there (kept or not)
     if (had < 0 || !levels[std::size_t(had)] || !levels[std::size_t(had)]->solved[L]) return std::nullopt;
@@ -693,14 +693,13 @@ WarmStarts estimates_reached(MPI_Comm group, const config::DatasetConfig& cfg,
     std::vector<double> u;
     bool found = true;
     if (core::rank(group) == 0) {
-      auto it = permutations->find(had);
-      if (it == permutations->end()) {
-        it = permutations->emplace(had, node_permutation(from.errors.fine_coords(), to.sp.problem->space().canonical_coords(), d)).first;
-        if (it->second.empty())  // not expected: both are the same mesh refined once
+      if (!*permutation) {
+        *permutation = node_permutation(from.errors.fine_coords(), to.sp.problem->space().canonical_coords(), d);
+        if ((*permutation)->empty())  // not expected: both are the same mesh refined once
           core::info(group, "shape {}: the estimate's refined nodes differ from level {}'s: its re-solves start from rest",
                      from.shape.shape_id, k);
       }
-      const auto& p = it->second;
+      const auto& p = **permutation;
       const std::vector<double>& fine = from.errors.fine_state(L);
       found = !p.empty() && fine.size() == p.size() * std::size_t(d);
       if (found) {
