@@ -305,6 +305,48 @@ TEST_CASE("A fine step that spends its Krylov budget is kept", "[error_estimate]
   CHECK(one.rel_l2 < 3.0 * converged.rel_l2);
 }
 
+TEST_CASE("A local relaxation is followed by a global step, however far it lowers the residual", "[error_estimate]") {
+  // The converged label with one interior node pushed off its equilibrium by delta: the fine
+  // residual of P u_h then sits on that node's patch, which the local relaxation removes. Under a
+  // small load (max|u| 0.02) the rest, the global error the unperturbed label's estimate
+  // measures, is below 1% of the first residual for delta 0.01 and 0.02 (0.8% and 0.3%; not for
+  // 0.005); the estimate must still take the fine Newton step that sees it. Until 2026-12-07 a
+  // relaxation that met the estimator's 1% criterion ended the estimate, which then saw only the
+  // relaxed node (checked: this test fails so, its states a whole correction apart; on Random2D one
+  // label estimated 6e-7 where its neighbours had 4e-3).
+  const EffectsMaker effects = clamped_box_effects;
+  Pair p = make_pair(mesh::mesh_box(2, 1.0, 0.125), 2, effects);
+  solver::NonlinearSolver ns(*p.coarse, solver::SolverOptions{});
+  const auto t = ns.solve_for_target(0.02);
+  REQUIRE(t.converged);
+  const solver::ErrorEstimate plain = p.est->estimate(ns.solution(), t.alpha);
+  REQUIRE(plain.ok);
+  physics::NodalField u = p.coarse->gather(ns.solution());
+  const std::vector<double>& xy = p.coarse->space().canonical_coords();
+  std::size_t node = 0;  // the node nearest (0.5, 0.5)
+  for (std::size_t i = 0; 2 * i < xy.size(); ++i)
+    if (std::hypot(xy[2 * i] - 0.5, xy[2 * i + 1] - 0.5) < std::hypot(xy[2 * node] - 0.5, xy[2 * node + 1] - 0.5)) node = i;
+  const double delta = GENERATE(0.005, 0.01, 0.02);
+  u.values[2 * node] += delta;
+  const core::VecH pushed = p.coarse->scatter(u.values);
+  const solver::ErrorEstimate e = p.est->estimate(pushed, t.alpha);
+  INFO("delta " << delta << ": unperturbed " << plain.rel_l2 << ", pushed " << e.rel_l2 << " after " << e.relaxations
+                << " relaxations and " << e.tangent_assemblies << " fine tangents");
+  REQUIRE(e.ok);
+  CHECK(e.relaxations >= 1);
+  CHECK(e.tangent_assemblies >= 2);  // the coarse tangent (the estimator factorises its own here) and a fine step
+  // Both estimates end next to the fine equilibrium: their states differ by far less than the
+  // global correction e of the unperturbed label (a relaxation alone leaves all of it out).
+  REQUIRE(e.fine_state.size() == plain.fine_state.size());
+  double diff = 0, norm = 0;
+  for (std::size_t i = 0; i < e.fine_state.size(); ++i) {
+    diff += std::pow(e.fine_state[i] - plain.fine_state[i], 2);
+    norm += std::pow(plain.fine_state[i], 2);
+  }
+  INFO("states apart by " << std::sqrt(diff / norm) << " of |u|; the unperturbed correction " << plain.raw_rel_l2);
+  CHECK(std::sqrt(diff / norm) < 0.3 * plain.raw_rel_l2);
+}
+
 TEST_CASE("A label that inverts inside a cell is flagged, not estimated", "[error_estimate]") {
   // u = (phi(x), 0) with phi' = x - x0 - 1: det F = x - x0, exactly linear in x (phi is in P2).
   // x0 below every quadrature point of the coarse cells but above the refined mesh's nearest
