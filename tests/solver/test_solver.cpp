@@ -258,18 +258,6 @@ TEST_CASE("Newton-Krylov on a kept factor reaches the fresh-Newton equilibrium w
   }
 }
 
-namespace {
-
-/// How often PETSc's own log saw `event` (logging must be on: PetscLogDefaultBegin).
-PetscLogDouble event_count(const char* event) {
-  PetscLogEvent ev;
-  PetscEventPerfInfo info{};
-  if (PetscLogEventGetId(event, &ev) != 0 || PetscLogEventGetPerfInfo(0, ev, &info) != 0) return -1;
-  return info.count;
-}
-
-}  // namespace
-
 TEST_CASE("The solver's factorisation and Krylov counters are exact", "[solver]") {
   HS_PETSC(PetscLogDefaultBegin());
   physics::Problem p{PETSC_COMM_WORLD, hstest::disk_mesh(0.2), hstest::disk_effects(), hstest::degree(1)};
@@ -280,8 +268,8 @@ TEST_CASE("The solver's factorisation and Krylov counters are exact", "[solver]"
     // iterations PETSc's log would count with the Newton-Krylov ones.
     HS_PETSC(PetscOptionsSetValue(nullptr, "-pc_factor_mat_ordering_type", "qmd"));
     solver::NonlinearSolver ns(p, opt);
-    const double fact0 = event_count("MatCholFctrNum"), sym0 = event_count("MatCholFctrSym"),
-                 its0 = event_count("KSPGMRESOrthog");
+    const double fact0 = hstest::event_count("MatCholFctrNum"), sym0 = hstest::event_count("MatCholFctrSym"),
+                 its0 = hstest::event_count("KSPGMRESOrthog");
     const solver::TargetResult t = ns.solve_for_target(0.3);
     ns.reset();
     const solver::TargetResult t2 = ns.solve_for_target(0.2);
@@ -294,9 +282,9 @@ TEST_CASE("The solver's factorisation and Krylov counters are exact", "[solver]"
     REQUIRE(t2.converged);
     // Each numeric (and symbolic) factorisation counted is one PETSc performed, and no other.
     CHECK(double(t.linear.numeric_factorizations + t2.linear.numeric_factorizations) ==
-          event_count("MatCholFctrNum") - fact0);
+          hstest::event_count("MatCholFctrNum") - fact0);
     CHECK(double(t.linear.symbolic_factorizations + t2.linear.symbolic_factorizations) ==
-          event_count("MatCholFctrSym") - sym0);
+          hstest::event_count("MatCholFctrSym") - sym0);
     // One symbolic analysis per factor kept (K(0) and the work factor, 2D), in the first solve only.
     CHECK(t.linear.symbolic_factorizations == 2);
     CHECK(t2.linear.symbolic_factorizations == 0);
@@ -309,7 +297,7 @@ TEST_CASE("The solver's factorisation and Krylov counters are exact", "[solver]"
     } else {
       // GMRES orthogonalises once per iteration: the Krylov count is PETSc's.
       CHECK(double(t.linear.krylov_iterations + t2.linear.krylov_iterations) ==
-            event_count("KSPGMRESOrthog") - its0);
+            hstest::event_count("KSPGMRESOrthog") - its0);
       CHECK(t2.linear.numeric_factorizations < t2.newton_iterations);
     }
   }
@@ -321,12 +309,12 @@ TEST_CASE("The blocked LDL^T's factorisations are counted as they happen", "[sol
   HS_PETSC(PetscLogDefaultBegin());
   physics::Problem p{PETSC_COMM_WORLD, hstest::disk_mesh(0.2), hstest::disk_effects(), hstest::degree(2)};
   solver::NonlinearSolver ns(p, solver::SolverOptions{});
-  const double own0 = event_count("HSFactorBlocked"), petsc0 = event_count("MatCholFctrNum");
+  const double own0 = hstest::event_count("HSFactorBlocked"), petsc0 = hstest::event_count("MatCholFctrNum");
   const solver::TargetResult t = ns.solve_for_target(0.3);
   REQUIRE(t.converged);
   CHECK(t.linear.numeric_factorizations > t.newton_iterations / 2);
-  CHECK(double(t.linear.numeric_factorizations) == event_count("HSFactorBlocked") - own0);
-  CHECK(event_count("MatCholFctrNum") == petsc0);
+  CHECK(double(t.linear.numeric_factorizations) == hstest::event_count("HSFactorBlocked") - own0);
+  CHECK(hstest::event_count("MatCholFctrNum") == petsc0);
 }
 
 TEST_CASE("Failed increments are recovered and their cost counted; a spent budget is a recorded failure", "[solver]") {

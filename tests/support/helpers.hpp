@@ -235,6 +235,14 @@ inline double asymmetry(Mat K) {
   return d / k;
 }
 
+/// How often PETSc's own log saw `event` (logging must be on: PetscLogDefaultBegin); -1 unknown.
+inline PetscLogDouble event_count(const char* event) {
+  PetscLogEvent ev;
+  PetscEventPerfInfo info{};
+  if (PetscLogEventGetId(event, &ev) != 0 || PetscLogEventGetPerfInfo(0, ev, &info) != 0) return -1;
+  return info.count;
+}
+
 inline hs::physics::SpaceOptions degree(int p) {
   hs::physics::SpaceOptions o;
   o.degree = p;
