@@ -469,7 +469,14 @@ void parse_accuracy(const YamlBlock& top, const std::string& source, DatasetConf
                       "re-solve from the state the level below's estimate reached)");
     acc.start_from_coarse = start == "coarse";
   }
-  a.allowed("rel_l2, max_level, exceed_share, start");
+  if (a.has("resolve_newton_budget")) {
+    const long b = a.integer("resolve_newton_budget");
+    if (b < 1 || b > 100000)
+      a.fail("resolve_newton_budget", "must be an integer in [1, 100000] (Newton iterations a re-solve above level 0 may "
+                                      "spend; default: solver.newton_budget)");
+    acc.resolve_newton_budget = int(b);
+  }
+  a.allowed("rel_l2, max_level, exceed_share, start, resolve_newton_budget");
   a.check_all_used();
   const YAML::Node rep = top.get("representations");
   if (rep && rep["error_estimate"] && !c.representations.error_estimate)

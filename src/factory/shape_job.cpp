@@ -731,6 +731,7 @@ void solve_by_accuracy(MPI_Comm group, const config::DatasetConfig& cfg, const S
     while (int(refined.size()) <= a.refinements) refined.push_back(refine_shape(refined.back()));
     config::DatasetConfig at = cfg;
     at.degree = a.degree;
+    if (k > 0 && cfg.accuracy.resolve_newton_budget > 0) at.solver.newton_budget = cfg.accuracy.resolve_newton_budget;
     lv = std::make_unique<Level>(group, at, refined[std::size_t(a.refinements)], cases[0], out.times);
     if (cfg.accuracy.start_from_coarse && k < cfg.accuracy.max_level && accuracy_level(cfg, k + 1).degree == a.degree)
       lv->errors.keep_fine_states();  // the next level's starts (estimates_reached)
@@ -749,11 +750,12 @@ void solve_by_accuracy(MPI_Comm group, const config::DatasetConfig& cfg, const S
       const int had = ladder.kept(l);
       const double before = levels[std::size_t(had)]->errors.rel_l2()[L], e = lv.errors.rel_l2()[L];
       if (ladder.record(l, k, lv.table.status[L] != 0, e)) continue;
-      core::info(group, "shape {} load {}: keeps its level-{} label (estimate {:.3g}): at level {} it {}{}",
+      core::info(group, "shape {} load {}: keeps its level-{} label (estimate {:.3g}): at level {} it {} ({} Newton iterations, {} factorisations){}",
                  drawn.shape_id, L, had, before, k,
                  !lv.table.status[L] ? "failed (" + lv.table.reasons[L] + ")"
                  : e < 0             ? fmt::format("had no estimate ({:g})", e)
                                      : fmt::format("estimated {:.3g}", e),
+                 lv.table.newton[L], lv.factorizations[L],
                  ladder.waiting(l) < 0     ? std::string()
                  : ladder.falls_back(l)    ? fmt::format("; it tries level {}, which it skipped", ladder.waiting(l))
                                            : fmt::format("; it climbs on to level {}", ladder.waiting(l)));

@@ -36,6 +36,7 @@ refuse '{rel_l2: 0.01, max_levle: 2}' 'accuracy.max_levle'
 refuse '{max_level: 2}' 'accuracy.rel_l2'
 refuse '{rel_l2: 0.01, max_level: 9}' 'accuracy.max_level'
 refuse '{rel_l2: 0.01, start: coarsest}' 'accuracy.start'
+refuse '{rel_l2: 0.01, resolve_newton_budget: 0}' 'accuracy.resolve_newton_budget'
 
 # shapes.py: every shape group of a dataset's shards, by id (the checks below import it).
 cat > "$work/shapes.py" <<'PY'
@@ -231,6 +232,35 @@ for sid, g in mixed.items():
         assert g["loads/error_estimate_rel_l2"][L] < p["loads/error_estimate_rel_l2"][L], (sid, L)
 assert carried > 0, "no shape mixes levels"
 print("labels carried from level 0:", carried)
+PY
+# The same bound with a re-solve budget of one Newton iteration: every re-solve fails within it and
+# keeps the label it had (the log says so, with its cost), so the labels are level 0's, the arrays
+# those of the config without the key; only loads/accuracy_tried records the climbs tried.
+printf '%s\naccuracy: {rel_l2: 0.16, max_level: 1, resolve_newton_budget: 1}\n' "$base" > "$work/capped.yaml"
+"$bin" generate "$work/capped.yaml" --progress 0 -o "$work/capped" > "$work/capped.txt" 2>&1 || fail "generate (capped)"
+PYTHONPATH="$work" /usr/bin/python3 - "$work/capped" "$work/plain" <<'PY' && grep -q "keeps its level-0 label .*at level 1 it failed .*(1 Newton iterations" "$work/capped.txt" \
+  && ok "resolve_newton_budget 1: every re-solve fails within it, the labels stay level 0's (arrays as without the key)" \
+  || { grep "keeps its" "$work/capped.txt" | head -3; fail "resolve_newton_budget"; }
+import sys
+import numpy as np
+from shapes import shapes
+capped, plain = shapes(sys.argv[1]), shapes(sys.argv[2])
+tried = 0
+for sid, g in capped.items():
+    p = plain[sid]
+    assert int(g.attrs["accuracy_level"]) == 0, sid
+    assert (g["loads/accuracy_level"][...] == 0).all(), sid
+    t = g["loads/accuracy_tried"][...]
+    assert (((t == 1) == (p["loads/error_estimate_rel_l2"][...] > 0.16))).all(), (sid, t)
+    tried += int(t.sum())
+    def arrays(h):
+        out = {}
+        h.visititems(lambda n, o: out.__setitem__(n, o[...]) if hasattr(o, "shape") and "accuracy_" not in n else None)
+        return out
+    a, b = arrays(g), arrays(p)
+    assert a.keys() == b.keys(), sorted(set(a) ^ set(b))
+    for k in a: assert a[k].shape == b[k].shape and (a[k] == b[k]).all(), (sid, k)
+assert tried > 0, "no label tried to climb"
 PY
 PYTHONPATH="$src/scripts" /usr/bin/python3 - "$work/mixed" <<'PY' && ok "hypershape_data: each sample's accuracy_level, and the summary's labels per level" \
   || fail "hypershape_data accuracy_level"

@@ -95,6 +95,15 @@ TEST_CASE("accuracy: is parsed, validated, implies the estimate and joins the id
         config::canonical_text(acc));
   CHECK_THAT(config::canonical_text(acc), Catch::Contains("accuracy: [0.01, 2, 0]\n"));
   CHECK_THAT(message(head + "accuracy: {rel_l2: 0.01, start: fine}\n"), Catch::Contains("accuracy.start"));
+  // resolve_newton_budget: the re-solves' Newton budget (default: the solver's), in the identity only when given.
+  CHECK(acc.accuracy.resolve_newton_budget == 0);
+  const auto capped = config::parse_dataset_text(head + "accuracy: {rel_l2: 0.01, resolve_newton_budget: 80}\n", "<test>");
+  CHECK(capped.accuracy.resolve_newton_budget == 80);
+  CHECK_THAT(config::canonical_text(capped), Catch::Contains("accuracy: [0.01, 2, 0, budget 80]\n"));
+  CHECK_THAT(message(head + "accuracy: {rel_l2: 0.01, resolve_newton_budget: 0}\n"),
+             Catch::Contains("accuracy.resolve_newton_budget"));
+  CHECK_THAT(message(head + "accuracy: {rel_l2: 0.01, resolve_newton_budget: 1.5}\n"),
+             Catch::Contains("accuracy.resolve_newton_budget"));
   CHECK_THAT(message(head + "accuracy: {rel_l2: 0}\n"), Catch::Contains("accuracy.rel_l2"));
   CHECK_THAT(message(head + "accuracy: {rel_l2: 1}\n"), Catch::Contains("accuracy.rel_l2"));
   CHECK_THAT(message(head + "accuracy: {rel_l2: 0.01, bound: 2}\n"), Catch::Contains("accuracy.bound"));

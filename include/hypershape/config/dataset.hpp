@@ -103,6 +103,10 @@ struct AccuracyConfig {
   /// from the state the level below's error estimate reached on its mesh (from rest where that
   /// fails): docs/ACCURACY.md, "A re-solve that starts where the estimate ended".
   bool start_from_coarse = false;
+  /// Newton iterations a re-solve (a level above 0) may spend, as solver.newton_budget bounds a
+  /// load case's solve (each try and rescue its own); 0: solver.newton_budget. A re-solve that
+  /// fails only keeps the label it had, so a dataset may cap what a climb costs.
+  int resolve_newton_budget = 0;
   bool enabled() const { return rel_l2 > 0; }
 };
 
