@@ -750,7 +750,9 @@ void solve_by_accuracy(MPI_Comm group, const config::DatasetConfig& cfg, const S
       const int had = ladder.kept(l);
       const double before = levels[std::size_t(had)]->errors.rel_l2()[L], e = lv.errors.rel_l2()[L];
       if (ladder.record(l, k, lv.table.status[L] != 0, e)) continue;
-      core::info(group, "shape {} load {}: keeps its level-{} label (estimate {:.3g}): at level {} it {} ({} Newton iterations, {} factorisations){}",
+      core::info(group,
+                 "shape {} load {}: keeps its level-{} label (estimate {:.3g}): at level {} it {} "
+                 "({} Newton iterations, {} factorisations){}",
                  drawn.shape_id, L, had, before, k,
                  !lv.table.status[L] ? "failed (" + lv.table.reasons[L] + ")"
                  : e < 0             ? fmt::format("had no estimate ({:g})", e)

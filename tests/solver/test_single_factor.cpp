@@ -113,9 +113,11 @@ TEST_CASE("A kept single-precision factor preconditions Newton-Krylov unrefined 
   const auto td = dbl.solve_for_target(0.3);
   const double products0 = hstest::event_count("MatMult"), orthog0 = hstest::event_count("KSPGMRESOrthog");
   const auto tk = kept.solve_for_target(0.3);
-  const double products = hstest::event_count("MatMult") - products0, gmres = hstest::event_count("KSPGMRESOrthog") - orthog0;
-  INFO("alpha " << tk.alpha << " (double " << td.alpha << "); factorisations " << tk.linear.numeric_factorizations << " (double "
-                << td.linear.numeric_factorizations << "), Krylov its " << tk.linear.krylov_iterations << ", products "
+  const double products = hstest::event_count("MatMult") - products0;
+  const double gmres = hstest::event_count("KSPGMRESOrthog") - orthog0;
+  INFO("alpha " << tk.alpha << " (double " << td.alpha << "); factorisations " << tk.linear.numeric_factorizations
+                << " (double " << td.linear.numeric_factorizations << "), Krylov its " << tk.linear.krylov_iterations
+                << ", products "
                 << products << ", GMRES orthogonalisations " << gmres);
   REQUIRE(td.converged);
   REQUIRE(tk.converged);
