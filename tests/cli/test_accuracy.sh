@@ -245,6 +245,10 @@ import sys
 import numpy as np
 from shapes import shapes
 capped, plain = shapes(sys.argv[1]), shapes(sys.argv[2])
+def arrays(h):  # every array of a shape group but the ladder's own
+    out = {}
+    h.visititems(lambda n, o: out.__setitem__(n, o[...]) if hasattr(o, "shape") and "accuracy_" not in n else None)
+    return out
 tried = 0
 for sid, g in capped.items():
     p = plain[sid]
@@ -253,10 +257,6 @@ for sid, g in capped.items():
     t = g["loads/accuracy_tried"][...]
     assert (((t == 1) == (p["loads/error_estimate_rel_l2"][...] > 0.16))).all(), (sid, t)
     tried += int(t.sum())
-    def arrays(h):
-        out = {}
-        h.visititems(lambda n, o: out.__setitem__(n, o[...]) if hasattr(o, "shape") and "accuracy_" not in n else None)
-        return out
     a, b = arrays(g), arrays(p)
     assert a.keys() == b.keys(), sorted(set(a) ^ set(b))
     for k in a: assert a[k].shape == b[k].shape and (a[k] == b[k]).all(), (sid, k)

@@ -6,7 +6,8 @@
 ///  - on the manufactured finite-strain solution of test_mms (smooth: the error falls like
 ///    h^(p+1), so -error_estimate_order p+1) the estimate falls at that rate and stays within
 ///    [0.5, 2] of the true error;
-///  - a field with det F <= 0 between the coarse quadrature points is flagged (inverted).
+///  - a field with det F <= 0 between the coarse quadrature points is flagged (inverted);
+///  - a local relaxation before the first fine step is always followed by a global one.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdio>
