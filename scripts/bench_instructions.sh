@@ -3,10 +3,11 @@
 # instructions each executes, in total and in the pieces of a load case (solver, tangent,
 # energy and residual passes, factorisation, local relaxation, shape draw, mesh, writes), side
 # by side, and whether the two datasets are the same array for array. Instruction counts do not
-# depend on the host's load (two runs of one binary agree to about 1e-5: allocation addresses and
-# clocks move a few branches): where a change leaves the data bit for bit and the load spreads whole
-# runs by more than the change (this 2-core VM: 5-15%), these are the figures to compare (they
-# count work, not time: a memory-bound loop or a memset counted per byte weighs differently).
+# depend on the host's load (two runs of one binary agree to about 1e-5, gmsh's meshing to ~1e-3:
+# allocation addresses and clocks move a few branches): where a change leaves the data bit for
+# bit and the load spreads whole runs by more than the change (this 2-core VM: 5-15%), these are
+# the figures to compare (they count work, not time: a memory-bound loop or a memset counted per
+# byte weighs differently).
 #   scripts/bench_instructions.sh OTHER_HYPERSHAPE [SHAPES] [LOADS]
 #   PRESET=random3d SEED=4343 scripts/bench_instructions.sh /tmp/old/build/hypershape 1 3
 # Environment: PRESET (default random2d), SEED (default 5151, a seed no tuning used),

@@ -3,7 +3,9 @@
 # (exit 2, nothing run); without valgrind the script says what to install (exit 2). With valgrind
 # (optional, not installed by setup.sh), the binary against itself on one Random2D load case:
 # the table printed, the same instructions in total and in the solves (callgrind's counts of one
-# binary agree between runs to about 1e-5), the datasets identical, the JSON written.
+# binary agree between runs to about 1e-5), the datasets identical, the JSON written. gmsh's own
+# count moves more between runs (1.4e-3 in one CI run: its containers of mesh entities are ordered
+# by address), so the mesh piece is held to 1e-2 and every other piece to 1e-3.
 source "$(dirname "$0")/lib.sh"
 script="$src/scripts/bench_instructions.sh"
 out=$(THIS_HYPERSHAPE="$bin" "$script" "$work/no-such-build" 2>&1); rc=$?
@@ -25,8 +27,8 @@ import json; j = json.load(open('src/results/bench_instructions.json'))
 c = j['instructions']; assert c['this'].keys() == c['other'].keys() and c['this']['whole process'] > 0, c
 for k, a in c['this'].items():
     b = c['other'][k]
-    assert a and b and abs(a / b - 1) < 1e-3, (k, a, b)" \
-    && ok "JSON: both builds' counts, within 1e-3 of each other" || fail "JSON"
+    assert a and b and abs(a / b - 1) < (1e-2 if k == 'mesh (gmsh)' else 1e-3), (k, a, b)" \
+    && ok "JSON: both builds' counts, within 1e-3 of each other (gmsh's 1e-2)" || fail "JSON"
 else
   grep -q "needs valgrind" <<<"$out" && ok "without valgrind: says what to install" || fail "message: $out"
 fi
