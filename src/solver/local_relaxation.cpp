@@ -123,30 +123,95 @@ bool LocalRelaxation::patch_energy(Vec u, double s, double& e) {
   return problem_.energy(u, s, e);
 }
 
+bool LocalRelaxation::seed_nodes(Vec r, std::vector<PetscInt>& seeds, double& total) const {
+  core::VecArray<const PetscScalar> ra(r);
+  const PetscInt n_nodes = PetscInt(gol_.size()) / dim_;
+  std::vector<double> node2(std::size_t(n_nodes), 0.0);
+  double largest = 0;
+  total = 0;
+  for (PetscInt n = 0; n < n_nodes; ++n) {
+    for (int i = 0; i < dim_; ++i)
+      if (const PetscInt g = gol_[std::size_t(n * dim_ + i)]; g >= 0) node2[std::size_t(n)] += ra[g] * ra[g];
+    total += node2[std::size_t(n)];
+    largest = std::max(largest, node2[std::size_t(n)]);
+  }
+  double seeded = 0;
+  for (PetscInt n = 0; n < n_nodes; ++n)
+    if (node2[std::size_t(n)] >= 0.01 * largest) {
+      seeds.push_back(n);
+      seeded += node2[std::size_t(n)];
+    }
+  return !(!(largest > 0) || seeds.size() > std::size_t(max_seeds_) || seeded < 0.5 * total);
+}
+
+/// The patch's tangent, sparse (a patch has hundreds of dofs in 2D, a thousand in 3D P2), and
+/// its Cholesky factor (AMD ordering, the pattern analysed once per patch) of K + mu I, mu from 0
+/// up until it is definite, so that the step descends on the patch's energy.
+struct LocalRelaxation::PatchFactor {
+  explicit PatchFactor(Eigen::Index n) : K(n, n) {}
+  /// Factorises K (shifted where it is not definite); `diagonal` = sum |K_ii|. False where no
+  /// shift up to 1e12 times the first made it definite.
+  bool factorise(double diagonal, bool analyse) {
+    if (analyse) llt.analyzePattern(K);
+    const double mu0 = 1e-3 * diagonal / double(K.cols());
+    llt.setShift(0.0);
+    llt.factorize(K);
+    for (double mu = mu0; llt.info() != Eigen::Success && mu < 1e12 * mu0; mu *= 4) {
+      llt.setShift(mu);
+      llt.factorize(K);
+    }
+    return llt.info() == Eigen::Success;
+  }
+  Eigen::SparseMatrix<double> K;
+  Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
+  std::vector<Eigen::Triplet<double>> entries;
+};
+
+bool LocalRelaxation::patch_tangent(Vec u, double s, PatchFactor& f, double& diagonal) {
+  {
+    physics::CellSubset only(problem_.space(), cells_);
+    if (!problem_.jacobian(u, K_, s)) return false;
+  }
+  f.entries.clear();
+  diagonal = 0;
+  for (Eigen::Index i = 0; i < f.K.cols(); ++i) {
+    PetscInt ncols;
+    const PetscInt* cols;
+    const PetscScalar* vals;
+    HS_PETSC(MatGetRow(K_, free_[std::size_t(i)], &ncols, &cols, &vals));
+    for (PetscInt k = 0; k < ncols; ++k)
+      if (const int j = position_[std::size_t(cols[k])]; j >= i) {
+        f.entries.emplace_back(int(j), int(i), vals[k]);  // the lower triangle, column i
+        if (j == i) diagonal += std::abs(vals[k]);
+      }
+    HS_PETSC(MatRestoreRow(K_, free_[std::size_t(i)], &ncols, &cols, &vals));
+  }
+  f.K.setFromTriplets(f.entries.begin(), f.entries.end());
+  return true;
+}
+
+bool LocalRelaxation::descend(Vec u, double s, const Eigen::VectorXd& d, double slope, double& e0) {
+  double lambda = 1.0, e = 0;
+  for (; lambda > 1e-6; lambda *= 0.5) {
+    HS_PETSC(VecCopy(u, trial_));
+    {
+      core::VecArray<PetscScalar> t(trial_);
+      for (Eigen::Index i = 0; i < d.size(); ++i) t[free_[std::size_t(i)]] += lambda * d[i];
+    }
+    if (patch_energy(trial_, s, e) && e <= e0 + 1e-4 * lambda * slope) break;
+  }
+  if (!(lambda > 1e-6)) return false;
+  HS_PETSC(VecCopy(trial_, u));
+  e0 = e;
+  return true;
+}
+
 LocalRelaxation::Result LocalRelaxation::relax(Vec u, double s, Vec r, Vec fixed) {
   LogEvent logged(events().relaxation);
   Result out;
   std::vector<PetscInt> seeds;
   double total = 0;
-  {
-    core::VecArray<const PetscScalar> ra(r);
-    const PetscInt n_nodes = PetscInt(gol_.size()) / dim_;
-    std::vector<double> node2(std::size_t(n_nodes), 0.0);
-    double largest = 0;
-    for (PetscInt n = 0; n < n_nodes; ++n) {
-      for (int i = 0; i < dim_; ++i)
-        if (const PetscInt g = gol_[std::size_t(n * dim_ + i)]; g >= 0) node2[std::size_t(n)] += ra[g] * ra[g];
-      total += node2[std::size_t(n)];
-      largest = std::max(largest, node2[std::size_t(n)]);
-    }
-    double seeded = 0;
-    for (PetscInt n = 0; n < n_nodes; ++n)
-      if (node2[std::size_t(n)] >= 0.01 * largest) {
-        seeds.push_back(n);
-        seeded += node2[std::size_t(n)];
-      }
-    if (!(largest > 0) || seeds.size() > std::size_t(max_seeds_) || seeded < 0.5 * total) return out;
-  }
+  if (!seed_nodes(r, seeds, total)) return out;
   {
     core::VecArray<const PetscScalar> fx(fixed);
     patch(seeds, fx.data());
@@ -161,57 +226,15 @@ LocalRelaxation::Result LocalRelaxation::relax(Vec u, double s, Vec r, Vec fixed
   const double outside = std::sqrt(std::max(total - rv.squaredNorm(), 0.0));
   const double goal = std::max(0.1 * outside, 1e-2 * out.before);
   constexpr int kMaxSteps = 10;
-  // The patch's tangent, sparse (a patch has hundreds of dofs in 2D, a thousand in 3D P2):
-  // Cholesky (AMD ordering, the pattern analysed once per patch) of K + mu I, mu from 0 up
-  // until it is definite, so that the step descends on the patch's energy.
-  Eigen::SparseMatrix<double> K(nf, nf);
-  Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
-  std::vector<Eigen::Triplet<double>> entries;
+  PatchFactor f(nf);
   double e0 = NAN;  // the patch's energy at u: the accepted trial's after the first step
   for (; out.iterations < kMaxSteps && out.after > goal; ++out.iterations) {
-    {
-      physics::CellSubset only(problem_.space(), cells_);
-      if (!problem_.jacobian(u, K_, s)) break;
-    }
-    entries.clear();
-    double diagonal = 0;
-    for (Eigen::Index i = 0; i < nf; ++i) {
-      PetscInt ncols;
-      const PetscInt* cols;
-      const PetscScalar* vals;
-      HS_PETSC(MatGetRow(K_, free_[std::size_t(i)], &ncols, &cols, &vals));
-      for (PetscInt k = 0; k < ncols; ++k)
-        if (const int j = position_[std::size_t(cols[k])]; j >= i) {
-          entries.emplace_back(int(j), int(i), vals[k]);  // the lower triangle, column i
-          if (j == i) diagonal += std::abs(vals[k]);
-        }
-      HS_PETSC(MatRestoreRow(K_, free_[std::size_t(i)], &ncols, &cols, &vals));
-    }
-    K.setFromTriplets(entries.begin(), entries.end());
-    if (out.iterations == 0) llt.analyzePattern(K);
-    const double mu0 = 1e-3 * diagonal / double(nf);
-    llt.setShift(0.0);
-    llt.factorize(K);
-    for (double mu = mu0; llt.info() != Eigen::Success && mu < 1e12 * mu0; mu *= 4) {
-      llt.setShift(mu);
-      llt.factorize(K);
-    }
-    if (llt.info() != Eigen::Success) break;
-    const Eigen::VectorXd d = -llt.solve(rv);
+    double diagonal;
+    if (!patch_tangent(u, s, f, diagonal) || !f.factorise(diagonal, out.iterations == 0)) break;
+    const Eigen::VectorXd d = -f.llt.solve(rv);
     const double slope = rv.dot(d);
     if (!(slope < 0) || (std::isnan(e0) && !patch_energy(u, s, e0))) break;
-    double lambda = 1.0, e = 0;
-    for (; lambda > 1e-6; lambda *= 0.5) {
-      HS_PETSC(VecCopy(u, trial_));
-      {
-        core::VecArray<PetscScalar> t(trial_);
-        for (Eigen::Index i = 0; i < nf; ++i) t[free_[std::size_t(i)]] += lambda * d[i];
-      }
-      if (patch_energy(trial_, s, e) && e <= e0 + 1e-4 * lambda * slope) break;
-    }
-    if (!(lambda > 1e-6)) break;
-    HS_PETSC(VecCopy(trial_, u));
-    e0 = e;
+    if (!descend(u, s, d, slope, e0)) break;
     out.relaxed = true;
     if (!patch_residual(u, s, rv)) break;  // (admissible: its energy was finite)
     out.after = rv.norm();

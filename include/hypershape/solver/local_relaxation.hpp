@@ -52,6 +52,18 @@ class LocalRelaxation {
   bool patch_residual(Vec u, double s, Eigen::VectorXd& rf);
   /// The energy at u with the patch's cells only (the rest is constant); false if inadmissible.
   bool patch_energy(Vec u, double s, double& e);
+  /// The trouble spot of r = R(u): the nodes with |R_node|^2 >= a hundredth of the largest, into
+  /// `seeds`; `total` = |r|^2. False where there is none to relax (r = 0, more than max_seeds_
+  /// nodes, or they hold less than half of |r|^2).
+  bool seed_nodes(Vec r, std::vector<PetscInt>& seeds, double& total) const;
+  struct PatchFactor;
+  /// The lower triangle of the patch's tangent at u on free_ into f.K (its pattern the same at
+  /// every call for one patch); `diagonal` = the sum of |K_ii|. False where u is inadmissible.
+  bool patch_tangent(Vec u, double s, PatchFactor& f, double& diagonal);
+  /// The energy line search along d (slope = R . d < 0) from the patch energy e0 at u: halved from
+  /// the whole step until Armijo's condition holds (down to 1e-6); u and e0 take the accepted
+  /// trial's. False (u unchanged) where none did.
+  bool descend(Vec u, double s, const Eigen::VectorXd& d, double slope, double& e0);
 
   const physics::Problem& problem_;
   int dim_;
