@@ -127,6 +127,21 @@ bool NonlinearSolver::relax_patch(PetscReal& rn) {
   return true;
 }
 
+bool NonlinearSolver::gives_up(int k, double rn, double rn0, const CreepWatch& creep, int its,
+                               std::string& why) const {
+  if (k == opt_.max_newton)
+    why = "no convergence in " + std::to_string(opt_.max_newton) + " Newton iterations";
+  else if (k >= 4 && rn > rn0)  // quadratic convergence would be far along by now
+    why = "no progress in " + std::to_string(k) + " Newton iterations";
+  else if (creep.creeping())
+    why = CreepWatch::reason;
+  else if (its >= opt_.newton_budget)
+    why = "Newton budget of " + std::to_string(opt_.newton_budget) + " iterations spent";
+  else
+    return false;
+  return true;
+}
+
 bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why) {
   LogEvent event(events().corrector);
   const double fnorm = problem_.load_norm();
@@ -161,22 +176,7 @@ bool NonlinearSolver::correct(double d, double rtol, int& its, std::string& why)
     const bool refreshed = k > 0 || rtol <= opt_.rtol;
     if (refreshed && rn <= opt_.atol + rtol * std::abs(s_) * fnorm && std::abs(g) <= gtol)
       return rtol > opt_.rtol || inertia_at_final_state(why);
-    if (k == opt_.max_newton) {
-      why = "no convergence in " + std::to_string(opt_.max_newton) + " Newton iterations";
-      return false;
-    }
-    if (k >= 4 && rn > rn0) {  // quadratic convergence would be far along by now
-      why = "no progress in " + std::to_string(k) + " Newton iterations";
-      return false;
-    }
-    if (creep.creeping()) {
-      why = CreepWatch::reason;
-      return false;
-    }
-    if (its >= opt_.newton_budget) {
-      why = "Newton budget of " + std::to_string(opt_.newton_budget) + " iterations spent";
-      return false;
-    }
+    if (gives_up(k, rn, rn0, creep, its, why)) return false;
     ++its;
     // Bordered system: K du - dalpha f = -R, c . du = d - m, with K^-1 f = a and K^-1 R = b
     // (a from the previous iterate's as the initial guess: the tangent moved little).

@@ -77,6 +77,8 @@
 
 namespace hypershape::solver {
 
+class CreepWatch;  // step_control.hpp
+
 /// How solve_for_target reaches its target max|u|.
 enum class Control {
   displacement,  ///< path-following in d = max|u| with alpha as an unknown (default)
@@ -400,6 +402,10 @@ class NonlinearSolver {
   /// current iterate in u_/s_; returns false with `why` set on failure. Leaves in `a_` the
   /// tangent response K^-1 f_ext of its last factorisation (the next predictor).
   bool correct(double d, double rtol, int& its, std::string& why);
+  /// Whether the corrector gives up before its iteration k (|R| = rn now, rn0 at its start;
+  /// `its` spent of the load case's budget): max_newton reached, no progress after 4, creeping,
+  /// or the budget spent; `why` says which.
+  bool gives_up(int k, double rn, double rn0, const CreepWatch& creep, int its, std::string& why) const;
   /// SolverOptions::local_relaxation: relaxes u_ on the patch where R (in r_) sits
   /// (LocalRelaxation); where it did, r_ and `rn` are the relaxed state's. One rank,
   /// conservative problems, not with multigrid.
