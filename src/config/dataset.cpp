@@ -476,7 +476,8 @@ void parse_accuracy(const YamlBlock& top, const std::string& source, DatasetConf
                                       "spend; default: solver.newton_budget)");
     acc.resolve_newton_budget = int(b);
   }
-  a.allowed("rel_l2, max_level, exceed_share, start, resolve_newton_budget");
+  acc.resolve_retries = flag(a, "resolve_retries", true);
+  a.allowed("rel_l2, max_level, exceed_share, start, resolve_newton_budget, resolve_retries");
   a.check_all_used();
   const YAML::Node rep = top.get("representations");
   if (rep && rep["error_estimate"] && !c.representations.error_estimate)

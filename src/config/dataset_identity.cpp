@@ -79,9 +79,10 @@ std::string canonical_text(const DatasetConfig& c) {
   if (c.quadrature) t += fmt::format("quadrature: {}\n", c.quadrature);  // only when given, as below
   if (r.error_estimate) t += "error_estimate: true\n";  // only when asked for: older datasets keep their identity
   if (const auto& a = c.accuracy; a.enabled())  // likewise
-    t += fmt::format("accuracy: [{}, {}, {}{}{}]\n", num(a.rel_l2), a.max_level, num(a.exceed_share),
+    t += fmt::format("accuracy: [{}, {}, {}{}{}{}]\n", num(a.rel_l2), a.max_level, num(a.exceed_share),
                      a.start_from_coarse ? ", coarse" : "",  // the default (rest): older identities unchanged
-                     a.resolve_newton_budget ? fmt::format(", budget {}", a.resolve_newton_budget) : "");  // likewise
+                     a.resolve_newton_budget ? fmt::format(", budget {}", a.resolve_newton_budget) : "",  // likewise
+                     a.resolve_retries ? "" : ", one try");  // likewise
   t += solver_text(c.solver);
   // PETSc options in a fixed order (the order they are written in does not matter).
   auto petsc = c.petsc;

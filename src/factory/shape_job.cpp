@@ -732,6 +732,7 @@ void solve_by_accuracy(MPI_Comm group, const config::DatasetConfig& cfg, const S
     config::DatasetConfig at = cfg;
     at.degree = a.degree;
     if (k > 0 && cfg.accuracy.resolve_newton_budget > 0) at.solver.newton_budget = cfg.accuracy.resolve_newton_budget;
+    if (k > 0 && !cfg.accuracy.resolve_retries) at.solver.retry_from_rest = at.solver.p1_start = false;
     lv = std::make_unique<Level>(group, at, refined[std::size_t(a.refinements)], cases[0], out.times);
     if (cfg.accuracy.start_from_coarse && k < cfg.accuracy.max_level && accuracy_level(cfg, k + 1).degree == a.degree)
       lv->errors.keep_fine_states();  // the next level's starts (estimates_reached)

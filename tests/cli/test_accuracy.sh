@@ -37,6 +37,7 @@ refuse '{max_level: 2}' 'accuracy.rel_l2'
 refuse '{rel_l2: 0.01, max_level: 9}' 'accuracy.max_level'
 refuse '{rel_l2: 0.01, start: coarsest}' 'accuracy.start'
 refuse '{rel_l2: 0.01, resolve_newton_budget: 0}' 'accuracy.resolve_newton_budget'
+refuse '{rel_l2: 0.01, resolve_retries: maybe}' 'accuracy.resolve_retries'
 
 # shapes.py: every shape group of a dataset's shards, by id (the checks below import it).
 cat > "$work/shapes.py" <<'PY'
@@ -262,6 +263,24 @@ for sid, g in capped.items():
     for k in a: assert a[k].shape == b[k].shape and (a[k] == b[k]).all(), (sid, k)
 assert tried > 0, "no label tried to climb"
 PY
+# With resolve_retries: false a re-solve makes one try: the budget-1 re-solves above went on to the
+# solver's P1 start ("P1 on the same mesh"); these fail without it, keeping the same labels.
+printf '%s\naccuracy: {rel_l2: 0.16, max_level: 1, resolve_newton_budget: 1, resolve_retries: false}\n' "$base" > "$work/once.yaml"
+"$bin" generate "$work/once.yaml" --progress 0 -o "$work/once" > "$work/once.txt" 2>&1 || fail "generate (once)"
+n_p1=$(grep -c "keeps its level-0 label .*P1 on the same mesh" "$work/capped.txt")
+n_once=$(grep -c "keeps its level-0 label .*at level 1 it failed (Newton budget of 1 iterations spent) (1 Newton" "$work/once.txt")
+if [ "$n_p1" -gt 0 ] && [ "$n_once" -eq "$(grep -c "keeps its" "$work/capped.txt")" ] && ! grep -q "P1 on the same mesh\|from rest without" "$work/once.txt" &&
+   PYTHONPATH="$work" /usr/bin/python3 - "$work/once" "$work/capped" <<'PY'
+import sys
+from shapes import shapes
+once, capped = shapes(sys.argv[1]), shapes(sys.argv[2])
+for sid, g in once.items():
+    c = capped[sid]
+    for k in ("status", "alpha", "displacement", "error_estimate_rel_l2", "accuracy_level", "accuracy_tried"):
+        assert (g[f"loads/{k}"][...] == c[f"loads/{k}"][...]).all(), (sid, k)
+PY
+then ok "resolve_retries false: each failed re-solve made one try ($n_once; with retries $n_p1 went on to the P1 start), the same labels"
+else grep "keeps its" "$work/once.txt" | head -3; fail "resolve_retries"; fi
 PYTHONPATH="$src/scripts" /usr/bin/python3 - "$work/mixed" <<'PY' && ok "hypershape_data: each sample's accuracy_level, and the summary's labels per level" \
   || fail "hypershape_data accuracy_level"
 import io, sys

@@ -104,6 +104,15 @@ TEST_CASE("accuracy: is parsed, validated, implies the estimate and joins the id
              Catch::Contains("accuracy.resolve_newton_budget"));
   CHECK_THAT(message(head + "accuracy: {rel_l2: 0.01, resolve_newton_budget: 1.5}\n"),
              Catch::Contains("accuracy.resolve_newton_budget"));
+  // resolve_retries: true (the default: the solver's retry from rest and P1 start in re-solves too)
+  // or false (one try), in the identity only when false.
+  CHECK(acc.accuracy.resolve_retries);
+  const auto once = config::parse_dataset_text(head + "accuracy: {rel_l2: 0.01, resolve_retries: false}\n", "<test>");
+  CHECK(!once.accuracy.resolve_retries);
+  CHECK_THAT(config::canonical_text(once), Catch::Contains("accuracy: [0.01, 2, 0, one try]\n"));
+  CHECK(config::canonical_text(config::parse_dataset_text(head + "accuracy: {rel_l2: 0.01, resolve_retries: true}\n",
+                                                          "<test>")) == config::canonical_text(acc));
+  CHECK_THAT(message(head + "accuracy: {rel_l2: 0.01, resolve_retries: 2}\n"), Catch::Contains("accuracy.resolve_retries"));
   CHECK_THAT(message(head + "accuracy: {rel_l2: 0}\n"), Catch::Contains("accuracy.rel_l2"));
   CHECK_THAT(message(head + "accuracy: {rel_l2: 1}\n"), Catch::Contains("accuracy.rel_l2"));
   CHECK_THAT(message(head + "accuracy: {rel_l2: 0.01, bound: 2}\n"), Catch::Contains("accuracy.bound"));

@@ -107,6 +107,11 @@ struct AccuracyConfig {
   /// load case's solve (each try and rescue its own); 0: solver.newton_budget. A re-solve that
   /// fails only keeps the label it had, so a dataset may cap what a climb costs.
   int resolve_newton_budget = 0;
+  /// false: a re-solve (a level above 0) makes one try, its branch switches included, without the
+  /// solver's outer rescues (solver.retry_from_rest and solver.p1_start), which keep a load case
+  /// from being lost; a re-solve that fails only keeps the label it had (docs/ACCURACY.md, "What a
+  /// re-solve may cost").
+  bool resolve_retries = true;
   bool enabled() const { return rel_l2 > 0; }
 };
 
