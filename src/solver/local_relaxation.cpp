@@ -141,7 +141,8 @@ bool LocalRelaxation::seed_nodes(Vec r, std::vector<PetscInt>& seeds, double& to
       seeds.push_back(n);
       seeded += node2[std::size_t(n)];
     }
-  return !(!(largest > 0) || seeds.size() > std::size_t(max_seeds_) || seeded < 0.5 * total);
+  const bool nothing_to_relax = !(largest > 0) || seeds.size() > std::size_t(max_seeds_) || seeded < 0.5 * total;
+  return !nothing_to_relax;
 }
 
 /// The patch's tangent, sparse (a patch has hundreds of dofs in 2D, a thousand in 3D P2), and
